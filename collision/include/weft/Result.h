@@ -1,0 +1,62 @@
+// Result<T>: a value or a readable error, returned at every public boundary that takes input.
+//
+// An error message names the input, what is wrong with it and what to do about it, e.g.
+//   "triangle 17 (vertices 4, 4, 9): repeated vertex index 4; every triangle needs three
+//    distinct vertices"
+// Nothing throws across the API; callers test ok() and read error().
+#pragma once
+
+#include <cassert>
+#include <optional>
+#include <string>
+#include <utility>
+
+namespace weft {
+
+/// A failed operation: a message for people, ready to print.
+struct Error {
+  std::string message;
+};
+
+/// Either a T or an Error. Cheap to move; value() asserts ok().
+template <typename T>
+class [[nodiscard]] Result {
+ public:
+  Result(T value) : m_value(std::move(value)) {}
+  Result(Error error) : m_error(std::move(error)) {}
+
+  bool ok() const { return m_value.has_value(); }
+  explicit operator bool() const { return ok(); }
+
+  const T& value() const& { assert(ok() && "Result::value() on an error; test ok() first"); return *m_value; }
+  T& value() & { assert(ok() && "Result::value() on an error; test ok() first"); return *m_value; }
+  T&& value() && { assert(ok() && "Result::value() on an error; test ok() first"); return std::move(*m_value); }
+
+  const T* operator->() const { return &value(); }
+  T* operator->() { return &value(); }
+
+  /// The error; empty message when ok().
+  const Error& error() const { return m_error; }
+
+ private:
+  std::optional<T> m_value;
+  Error m_error;
+};
+
+/// Result of an operation with no value: ok, or an error.
+class [[nodiscard]] Status {
+ public:
+  Status() = default;
+  Status(Error error) : m_error(std::move(error)), m_ok(false) {}
+  static Status success() { return {}; }
+
+  bool ok() const { return m_ok; }
+  explicit operator bool() const { return m_ok; }
+  const Error& error() const { return m_error; }
+
+ private:
+  Error m_error;
+  bool m_ok = true;
+};
+
+}  // namespace weft

@@ -1,0 +1,164 @@
+// ClothModel: the immutable topology and rest state of one piece of cloth.
+//
+// Built once (from a rectangular grid, a triangle mesh or an OBJ file) and shared by every cloth
+// instance made from it, in the manner of Jolt's SoftBodySharedSettings. It holds only what does
+// not depend on the material: rest parameterisation per triangle, bending hinges, springs for the
+// mass-spring model and lumped vertex areas. Materials (stiffness, density, damping) are applied
+// per instance, so one model serves cotton and denim alike.
+//
+// Rest parameterisation (Baraff & Witkin 1998, §4.1): every triangle carries material
+// coordinates (u, v) for its vertices, in metres; u runs along the warp, v along the weft. The
+// deformation map w(u, v) has the constant gradient per triangle
+//
+//     [w_u  w_v] = [x1 - x0   x2 - x0] · [u1 - u0   u2 - u0]^-1
+//                                         [v1 - v0   v2 - v0]
+//
+// so w_u and w_v are fixed linear combinations of the three positions. TriangleRest stores the
+// weights of those combinations; the force kernels never see (u, v) again.
+//
+// Hinge convention (one per interior edge, for bending):
+//
+//            x2
+//           /  \          triangle A = (x0, x1, x2), with the edge x0 -> x1 in its winding
+//          /  A \         triangle B holds the same edge and the vertex x3
+//        x0 ---- x1       the dihedral angle is measured about e = x1 - x0, 0 when flat
+//          \  B /
+//           \  /
+//            x3
+#pragma once
+
+#include <weft/Math.h>
+#include <weft/Result.h>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace weft {
+
+/// Rest state of one triangle for the Baraff–Witkin stretch and shear conditions.
+struct TriangleRest {
+  std::array<Index, 3> vertices{};  ///< x0, x1, x2 in the mesh's winding
+  Real area = 0;                    ///< m², rest area in material space
+  std::array<Real, 3> warpWeights{};  ///< 1/m; w_u = Σ warpWeights[i] · x_i
+  std::array<Real, 3> weftWeights{};  ///< 1/m; w_v = Σ weftWeights[i] · x_i
+};
+
+/// Rest state of one interior edge for the dihedral bending condition (see the drawing above).
+struct Hinge {
+  std::array<Index, 4> vertices{};  ///< x0, x1 (the edge), x2 (in triangle A), x3 (in triangle B)
+  std::array<Index, 2> triangles{}; ///< A and B, indices into ClothModel::triangles()
+  Real restAngle = 0;               ///< rad, dihedral angle of the rest shape (0 for flat cloth)
+  Real restLength = 0;              ///< m, rest length of the edge
+  /// 1/m⁰ (dimensionless): 3 l² / (A_A + A_B). Bending energy = D/2 · scale · (θ − θ_rest)², so a
+  /// bending stiffness D in N·m gives the same curvature energy on any mesh resolution.
+  Real stiffnessScale = 0;
+};
+
+/// The three spring families of the classic mass-spring cloth (Provot 1995).
+enum class SpringKind : std::uint8_t {
+  Structural,  ///< along warp and weft (grid) or along mesh edges
+  Shear,       ///< grid diagonals, or the quad diagonal across an interior edge
+  Flexion,     ///< skip-one neighbours along straight lines: resist bending
+};
+
+/// One spring of the mass-spring network.
+struct Spring {
+  std::array<Index, 2> vertices{};
+  Real restLength = 0;  ///< m
+  SpringKind kind = SpringKind::Structural;
+};
+
+/// An undirected mesh edge and the triangles on either side.
+struct Edge {
+  std::array<Index, 2> vertices{};     ///< smaller index first
+  std::array<Index, 2> triangles{kInvalidIndex, kInvalidIndex};  ///< second is invalid on a border
+  Real restLength = 0;                 ///< m
+};
+
+/// A rectangular grid of vertices, each quad split in two along its (r, c)–(r+1, c+1) diagonal.
+/// Vertex index = row · columns + column; row 0 lies at `origin`, rows grow along `heightAxis`.
+struct GridSettings {
+  Index columns = 41;               ///< vertices along the width (warp); at least 2
+  Index rows = 31;                  ///< vertices along the height (weft); at least 2
+  Real width = 2.0;                 ///< m, extent along widthAxis
+  Real height = 1.5;                ///< m, extent along heightAxis
+  Vec3 origin{-1.0, 0.5, 0.0};      ///< m, position of vertex (row 0, column 0)
+  Vec3 widthAxis{1.0, 0.0, 0.0};    ///< unit direction of growing columns (the warp)
+  Vec3 heightAxis{0.0, 1.0, 0.0};   ///< unit direction of growing rows (the weft)
+};
+
+/// A triangle mesh as read from a file or handed over by a game.
+struct TriangleMesh {
+  Vec3Array positions;           ///< m, rest positions
+  std::vector<Index> indices;    ///< three per triangle
+  /// Optional per-vertex material coordinates (u = warp, v = weft) in metres. Empty: each
+  /// triangle is flattened isometrically, with u along `warpDirection` projected into its plane.
+  std::vector<Vec2> materialCoordinates;
+};
+
+/// How a mesh becomes a cloth model.
+struct MeshSettings {
+  Vec3 warpDirection{1.0, 0.0, 0.0};  ///< direction of the warp (u) when no material coordinates
+  /// Reject edges shared by more than two triangles (bending needs a manifold). When false, such
+  /// edges simply get no hinge.
+  bool requireManifold = true;
+  /// A triangle whose area is below this fraction of its longest edge squared is degenerate.
+  Real degenerateAreaRatio = 1e-8;
+};
+
+/// Immutable cloth topology and rest state. Build with grid(), fromMesh() or loadObj().
+class ClothModel {
+ public:
+  /// A rectangular grid with the classic structural/shear/flexion spring network.
+  static Result<ClothModel> grid(const GridSettings& settings);
+  /// A general triangle mesh; validated (indices, finiteness, degeneracy, manifoldness).
+  static Result<ClothModel> fromMesh(const TriangleMesh& mesh, const MeshSettings& settings = {});
+  /// Reads positions and triangles (polygons are fanned) from a Wavefront OBJ file.
+  static Result<TriangleMesh> readObj(const std::string& path);
+  /// readObj() followed by fromMesh().
+  static Result<ClothModel> loadObj(const std::string& path, const MeshSettings& settings = {});
+
+  Index vertexCount() const { return static_cast<Index>(m_restPositions.size()); }
+  Index triangleCount() const { return static_cast<Index>(m_triangles.size()); }
+
+  const Vec3Array& restPositions() const { return m_restPositions; }
+  /// Three vertex indices per triangle, in the mesh's winding (for rendering and collision).
+  const std::vector<Index>& indices() const { return m_indices; }
+  const std::vector<TriangleRest>& triangles() const { return m_triangles; }
+  const std::vector<Hinge>& hinges() const { return m_hinges; }
+  const std::vector<Edge>& edges() const { return m_edges; }
+  const std::vector<Spring>& springs() const { return m_springs; }
+  /// m², a third of the rest area of every triangle around each vertex (lumped mass = ρ_A · area).
+  const std::vector<Real>& vertexAreas() const { return m_vertexAreas; }
+  /// m², total rest area.
+  Real totalArea() const { return m_totalArea; }
+  /// kg, total mass at an areal density in kg/m².
+  Real totalMass(Real arealDensity) const { return arealDensity * m_totalArea; }
+  /// kg per vertex at an areal density in kg/m² (lumped: a third of each adjacent triangle).
+  std::vector<Real> vertexMasses(Real arealDensity) const;
+  /// m, the diagonal of the rest bounding box: the length errors are divided by.
+  Real characteristicLength() const { return m_characteristicLength; }
+  /// Grid dimensions when built by grid(), {0, 0} otherwise.
+  std::array<Index, 2> gridSize() const { return m_gridSize; }
+
+ private:
+  ClothModel() = default;
+  static Result<ClothModel> build(const TriangleMesh& mesh, const MeshSettings& settings,
+                                  const std::vector<Vec2>& perCornerMaterialCoordinates);
+  void buildMeshSprings();
+
+  Vec3Array m_restPositions;
+  std::vector<Index> m_indices;
+  std::vector<TriangleRest> m_triangles;
+  std::vector<Hinge> m_hinges;
+  std::vector<Edge> m_edges;
+  std::vector<Spring> m_springs;
+  std::vector<Real> m_vertexAreas;
+  Real m_totalArea = 0;
+  Real m_characteristicLength = 0;
+  std::array<Index, 2> m_gridSize{0, 0};
+};
+
+}  // namespace weft
