@@ -1,0 +1,84 @@
+// Baraff–Witkin cloth conditions: stretch, shear and dihedral bending, with exact derivatives.
+//
+// Baraff & Witkin, "Large Steps in Cloth Simulation", SIGGRAPH 1998, §4.2–4.3. Each function is a
+// pure kernel of a few positions and the element's rest state, returning Condition<N> (Condition.h);
+// the loop over the mesh and the assembly live elsewhere.
+//
+// Stretch and shear (triangle x0, x1, x2 with rest data from makeTriangleRest):
+//
+//     w_u = Σ warpWeights[i] x_i,  w_v = Σ weftWeights[i] x_i      (BW98 eq. 9)
+//     C_warp  = √a (|w_u| − b_u)        C_weft = √a (|w_v| − b_v)       C_shear = √a (w_u · w_v)
+//
+// BW98 scale by the rest area a; we scale by √a so that E = k/2 C² = k a/2 (|w| − b)²: an energy
+// density times area, with k in N/m whatever the mesh resolution.
+//
+// Bending (hinge x0, x1, x2, x3, drawn as in ClothModel.h):
+//
+//            x2                 n_A = (x1 − x0) × (x2 − x0)   normal of A = (x0, x1, x2)
+//           /  \                n_B = (x3 − x0) × (x1 − x0)   normal of B = (x1, x0, x3), i.e.
+//          /  A \                                             wound consistently with A
+//        x0 ---- x1   e = x1 − x0
+//          \  B /               θ = atan2(ê · (n_B × n_A), n_A · n_B)  ∈ (−π, π]
+//           \  /
+//            x3
+//
+// Sign: θ = 0 when flat; θ > 0 when the cloth folds towards A's normal (triangle B rotates about
+// the edge into the half-space n_A points to: a valley seen from the n_A side), θ < 0 when it folds
+// away (a ridge seen from the n_A side). With the unnormalised normals the atan2 form is robust
+// near 0 and ±π, where acos would lose all precision.
+//
+// C_bend = √scale · wrap(θ − θ_rest) with scale = 3 l²/(A_A + A_B) (hingeStiffnessScale), so that
+// E = D/2 · scale · (θ − θ_rest)² approximates the continuum energy D/2 κ² per area with D in N·m.
+// The bend gradient and Hessian are exact: derivatives of θ(z) with respect to z = (n_A, n_B, e),
+// chained through the bilinear maps z(x) including their constant second derivatives.
+//
+// Degenerate geometry (|w| ≈ 0, collapsed edges, zero-area triangles) gives a finite value and a
+// zero gradient and Hessian for that condition: the direction the force would act in is undefined,
+// and zero is the only choice that cannot inject energy.
+#pragma once
+
+#include <forces/Condition.h>
+#include <weft/Math.h>
+#include <weft/engine/ClothModel.h>
+
+#include <array>
+
+namespace weft {
+
+/// Rest data of a triangle from the material coordinates (u, v) of its vertices, in metres: area
+/// = |det|/2 and the weights with w_u = Σ warpWeights[i] x_i, w_v = Σ weftWeights[i] x_i.
+/// Precondition: the (u, v) triangle is not degenerate (ClothModel validates its input).
+TriangleRest makeTriangleRest(std::array<Index, 3> vertices, const Vec2& uv0, const Vec2& uv1,
+                              const Vec2& uv2);
+
+/// The warp (u) and weft (v) stretch conditions of one triangle.
+struct StretchConditions {
+  Condition<3> warp;  ///< √a (|w_u| − b_u), in m (E = k/2 C², k in N/m)
+  Condition<3> weft;  ///< √a (|w_v| − b_v), in m
+};
+
+/// Stretch conditions of triangle (x0, x1, x2). The rest scales b_u, b_v are the stretch ratios
+/// at rest (1 = unstretched; < 1 pre-tensions the cloth). Hessians filled when `withHessian`.
+StretchConditions stretchConditions(const Vec3& x0, const Vec3& x1, const Vec3& x2,
+                                    const TriangleRest& rest, Real warpRestScale,
+                                    Real weftRestScale, bool withHessian);
+
+/// Shear condition √a (w_u · w_v) of triangle (x0, x1, x2): zero while warp and weft stay
+/// orthogonal. Not convex. Hessian filled when `withHessian`.
+Condition<3> shearCondition(const Vec3& x0, const Vec3& x1, const Vec3& x2,
+                            const TriangleRest& rest, bool withHessian);
+
+/// Signed dihedral angle of the hinge (x0, x1, x2, x3) in (−π, π], rad: 0 when flat, positive
+/// when the cloth folds towards the normal of triangle A = (x0, x1, x2). 0 for degenerate input.
+Real dihedralAngle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3);
+
+/// Dimensionless 3 l² / (A_A + A_B) for a hinge of rest length l (m) between triangles of rest
+/// areas A_A, A_B (m²); 0 when the areas do not sum to a positive value.
+Real hingeStiffnessScale(Real restLength, Real areaA, Real areaB);
+
+/// Bending condition √(hinge.stiffnessScale) · wrap(θ − hinge.restAngle), wrapped into (−π, π],
+/// for the hinge (x0, x1, x2, x3) in the order of Hinge::vertices. Exact Hessian when asked.
+Condition<4> bendCondition(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3,
+                           const Hinge& hinge, bool withHessian);
+
+}  // namespace weft

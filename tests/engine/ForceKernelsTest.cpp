@@ -1,0 +1,848 @@
+// Tests of the pure force kernels (forces/Condition.h, BaraffWitkin.h, SpringCondition.h), alone.
+//
+// Every derivative is checked against central finite differences of the quantity it differentiates
+// (C, the energy, the force), on random non-trivially deformed elements at two scales (1 m and a
+// cloth-sized 5 cm) and, for bending, on hand-made near-flat, strongly folded and near ±π hinges.
+// The step is 1e-6 of the element size and errors are compared in norm, relative to the larger
+// of the two matrices: central differences are accurate to ~1e-10 there, so 1e-6 catches any
+// wrong term while never tripping on rounding.
+#include <forces/BaraffWitkin.h>
+#include <forces/Condition.h>
+#include <forces/SpringCondition.h>
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <functional>
+#include <numbers>
+#include <random>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace weft {
+namespace {
+
+constexpr Real kPi = std::numbers::pi_v<Real>;
+/// Finite-difference step as a fraction of the element size.
+constexpr Real kRelativeStep = 1e-6;
+/// Allowed norm-relative error between analytic and finite-difference derivatives.
+constexpr Real kTolerance = 1e-6;
+
+template <int N>
+using Positions = Eigen::Matrix<Real, 3 * N, 1>;
+template <int N>
+using ConditionFunction = std::function<Condition<N>(const Positions<N>&, bool withHessian)>;
+
+/// One element to test: a condition, where to evaluate it, and the length scale of the element.
+template <int N>
+struct Case {
+  std::string name;
+  ConditionFunction<N> condition;
+  Positions<N> positions;
+  Real size = 1;  ///< m, sets the finite-difference step
+};
+
+Real relativeError(const Eigen::MatrixXd& actual, const Eigen::MatrixXd& expected) {
+  const Real scale = std::max({actual.norm(), expected.norm(), Real(1e-300)});
+  return (actual - expected).norm() / scale;
+}
+
+/// Central differences of a scalar function of the element positions.
+template <int N>
+Positions<N> finiteDifferenceGradient(const std::function<Real(const Positions<N>&)>& f,
+                                      const Positions<N>& x, Real step) {
+  Positions<N> gradient;
+  for (int i = 0; i < 3 * N; ++i) {
+    Positions<N> plus = x, minus = x;
+    plus[i] += step;
+    minus[i] -= step;
+    gradient[i] = (f(plus) - f(minus)) / (2 * step);
+  }
+  return gradient;
+}
+
+/// Central differences of a vector function: column j is ∂f/∂x_j.
+template <int N>
+Eigen::Matrix<Real, 3 * N, 3 * N> finiteDifferenceJacobian(
+    const std::function<Positions<N>(const Positions<N>&)>& f, const Positions<N>& x, Real step) {
+  Eigen::Matrix<Real, 3 * N, 3 * N> jacobian;
+  for (int j = 0; j < 3 * N; ++j) {
+    Positions<N> plus = x, minus = x;
+    plus[j] += step;
+    minus[j] -= step;
+    jacobian.col(j) = (f(plus) - f(minus)) / (2 * step);
+  }
+  return jacobian;
+}
+
+template <int N>
+ElementForces<N> elementForces(const Condition<N>& condition, Real stiffness, Real damping,
+                               const Positions<N>& velocities, StiffnessMode mode) {
+  ElementForces<N> forces;
+  accumulateConditionForces(condition, stiffness, damping, velocities, mode, true, forces);
+  return forces;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Configurations
+
+class Random {
+ public:
+  explicit Random(unsigned seed) : m_engine(seed) {}
+  Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<Real>(lo, hi)(m_engine); }
+  Vec3 vector(Real amplitude) {
+    return Vec3(uniform(-amplitude, amplitude), uniform(-amplitude, amplitude),
+                uniform(-amplitude, amplitude));
+  }
+  Mat3 rotation() {
+    Eigen::Quaternion<Real> q(uniform(-1, 1), uniform(-1, 1), uniform(-1, 1), uniform(-1, 1));
+    q.normalize();
+    return q.toRotationMatrix();
+  }
+
+ private:
+  std::mt19937 m_engine;
+};
+
+/// A triangle with material coordinates and a deformed placement x_i = F uv_i + t + noise.
+struct TriangleSetup {
+  std::array<Vec2, 3> uv;
+  TriangleRest rest;
+  Positions<3> positions;
+  Real size = 1;
+};
+
+std::array<Vec2, 3> randomMaterialTriangle(Random& random, Real size) {
+  // Perturbed right triangle: far from degenerate, with no special alignment to u or v.
+  const Vec2 uv0(random.uniform(-size, size), random.uniform(-size, size));
+  const Vec2 uv1 = uv0 + size * Vec2(1 + random.uniform(-0.3, 0.3), random.uniform(-0.3, 0.3));
+  const Vec2 uv2 = uv0 + size * Vec2(random.uniform(-0.3, 0.3), 1 + random.uniform(-0.3, 0.3));
+  return {uv0, uv1, uv2};
+}
+
+/// Places the material triangle through the 3×2 deformation gradient `deformation`, then a
+/// rotation, a translation and per-vertex noise of relative amplitude `noise`.
+TriangleSetup placeTriangle(const std::array<Vec2, 3>& uv, const Eigen::Matrix<Real, 3, 2>& deformation,
+                            const Mat3& rotation, const Vec3& translation, Random& random,
+                            Real noise, Real size) {
+  TriangleSetup setup;
+  setup.uv = uv;
+  setup.rest = makeTriangleRest({0, 1, 2}, uv[0], uv[1], uv[2]);
+  for (int i = 0; i < 3; ++i) {
+    setup.positions.segment<3>(3 * i) =
+        rotation * (deformation * uv[i]) + translation + random.vector(noise * size);
+  }
+  setup.size = size;
+  return setup;
+}
+
+Eigen::Matrix<Real, 3, 2> planarDeformation(Real a, Real b, Real c, Real d) {
+  Eigen::Matrix<Real, 3, 2> deformation;
+  deformation << a, b, c, d, 0, 0;
+  return deformation;
+}
+
+TriangleSetup randomTriangle(Random& random, Real size) {
+  Eigen::Matrix<Real, 3, 2> deformation = planarDeformation(1, 0, 0, 1);
+  // Stretch, shear and bend the map out of plane by up to ~40 %.
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 2; ++j) {
+      deformation(i, j) += random.uniform(-0.4, 0.4);
+    }
+  }
+  return placeTriangle(randomMaterialTriangle(random, size), deformation, random.rotation(),
+                       random.vector(2), random, 0.1, size);
+}
+
+/// A hinge with dihedral angle exactly `angle` (when noise = 0), rigidly moved, then perturbed.
+Positions<4> hingePositions(Random& random, Real angle, Real size, Real noise) {
+  // Edge along +x; A in the z = 0 plane above it (n_A = +z); B below, rotated about the edge so
+  // that it turns towards +z (towards n_A) for positive angles.
+  const Real reachA = random.uniform(0.5, 1.0);
+  const Real reachB = random.uniform(0.5, 1.0);
+  const std::array<Vec3, 4> local = {
+      Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(random.uniform(0, 1), reachA, 0),
+      Vec3(random.uniform(0, 1), -reachB * std::cos(angle), reachB * std::sin(angle))};
+  const Mat3 rotation = random.rotation();
+  const Vec3 translation = random.vector(2);
+  Positions<4> positions;
+  for (int i = 0; i < 4; ++i) {
+    positions.segment<3>(3 * i) =
+        rotation * (size * local[i]) + translation + random.vector(noise * size);
+  }
+  return positions;
+}
+
+Hinge hingeFor(const Positions<4>& positions, Real restAngle) {
+  Hinge hinge;
+  hinge.vertices = {0, 1, 2, 3};
+  hinge.restAngle = restAngle;
+  const Vec3 x0 = positions.segment<3>(0), x1 = positions.segment<3>(3);
+  const Vec3 x2 = positions.segment<3>(6), x3 = positions.segment<3>(9);
+  hinge.restLength = (x1 - x0).norm();
+  const Real areaA = (x1 - x0).cross(x2 - x0).norm() / 2;
+  const Real areaB = (x3 - x0).cross(x1 - x0).norm() / 2;
+  hinge.stiffnessScale = hingeStiffnessScale(hinge.restLength, areaA, areaB);
+  return hinge;
+}
+
+ConditionFunction<3> warpCondition(const TriangleRest& rest, Real warpScale, Real weftScale) {
+  return [=](const Positions<3>& x, bool withHessian) {
+    return stretchConditions(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), rest, warpScale,
+                             weftScale, withHessian)
+        .warp;
+  };
+}
+
+ConditionFunction<3> weftCondition(const TriangleRest& rest, Real warpScale, Real weftScale) {
+  return [=](const Positions<3>& x, bool withHessian) {
+    return stretchConditions(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), rest, warpScale,
+                             weftScale, withHessian)
+        .weft;
+  };
+}
+
+ConditionFunction<3> shearConditionOf(const TriangleRest& rest) {
+  return [=](const Positions<3>& x, bool withHessian) {
+    return shearCondition(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), rest, withHessian);
+  };
+}
+
+ConditionFunction<4> bendConditionOf(const Hinge& hinge) {
+  return [=](const Positions<4>& x, bool withHessian) {
+    return bendCondition(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), x.segment<3>(9),
+                         hinge, withHessian);
+  };
+}
+
+ConditionFunction<2> springConditionOf(Real restLength) {
+  return [=](const Positions<2>& x, bool withHessian) {
+    return springCondition(x.segment<3>(0), x.segment<3>(3), restLength, withHessian);
+  };
+}
+
+/// Stretch warp, stretch weft and shear on random deformed triangles at 1 m and 5 cm.
+std::vector<Case<3>> triangleCases() {
+  std::vector<Case<3>> cases;
+  Random random(7);
+  for (Real size : {1.0, 0.05}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      const TriangleSetup setup = randomTriangle(random, size);
+      const Real warpScale = random.uniform(0.9, 1.1);
+      const Real weftScale = random.uniform(0.9, 1.1);
+      const std::string suffix = " size " + std::to_string(size) + " #" + std::to_string(trial);
+      cases.push_back({"warp" + suffix, warpCondition(setup.rest, warpScale, weftScale),
+                       setup.positions, size});
+      cases.push_back({"weft" + suffix, weftCondition(setup.rest, warpScale, weftScale),
+                       setup.positions, size});
+      cases.push_back({"shear" + suffix, shearConditionOf(setup.rest), setup.positions, size});
+    }
+  }
+  return cases;
+}
+
+/// Bending on random, near-flat, strongly folded and near ±π hinges, with flat and curved rest.
+std::vector<Case<4>> hingeCases() {
+  std::vector<Case<4>> cases;
+  Random random(11);
+  auto add = [&](const std::string& name, Real angle, Real restAngle, Real size, Real noise) {
+    const Positions<4> positions = hingePositions(random, angle, size, noise);
+    // Rest data from a flat copy, so the stiffness scale is that of a real rest hinge.
+    const Hinge hinge = hingeFor(hingePositions(random, 0, size, 0), restAngle);
+    cases.push_back({name, bendConditionOf(hinge), positions, size});
+  };
+  for (Real size : {1.0, 0.05}) {
+    for (int trial = 0; trial < 4; ++trial) {
+      add("random #" + std::to_string(trial), random.uniform(-2.5, 2.5), 0, size, 0.1);
+    }
+    add("near flat", 1e-4, 0, size, 0);
+    add("exactly flat, curved rest", 0, 0.6, size, 0);
+    add("folded towards A", 2.7, 0, size, 0.02);
+    add("folded away from A", -2.7, 0, size, 0.02);
+    add("near +pi", kPi - 1e-3, 0, size, 0);
+    add("near -pi", -kPi + 1e-3, 0, size, 0);
+    add("near -pi, rest near +pi (wraps)", -kPi + 0.05, kPi - 0.1, size, 0);
+    add("curved rest", 0.9, -0.4, size, 0.05);
+  }
+  return cases;
+}
+
+/// Springs stretched and compressed, at 1 m and 5 cm.
+std::vector<Case<2>> springCases() {
+  std::vector<Case<2>> cases;
+  Random random(13);
+  for (Real size : {1.0, 0.05}) {
+    for (Real ratio : {0.5, 0.9, 1.2, 1.7}) {
+      const Vec3 x0 = random.vector(2);
+      const Vec3 direction = random.rotation() * Vec3::UnitX();
+      Positions<2> positions;
+      positions << x0, x0 + ratio * size * direction;
+      cases.push_back({"length ratio " + std::to_string(ratio) + " size " + std::to_string(size),
+                       springConditionOf(size), positions, size});
+    }
+  }
+  return cases;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Generic checks, applied to every condition
+
+/// ∇C and ∇²C against finite differences of C and ∇C; Hessian symmetry; ∇C with and without
+/// Hessian agree; the elastic force is minus the finite-difference gradient of the energy.
+template <int N>
+void expectDerivativesMatchFiniteDifferences(const Case<N>& element) {
+  SCOPED_TRACE(element.name);
+  const Real step = kRelativeStep * element.size;
+  const Condition<N> condition = element.condition(element.positions, true);
+  ASSERT_TRUE(std::isfinite(condition.value));
+
+  const auto value = [&](const Positions<N>& x) { return element.condition(x, false).value; };
+  EXPECT_LE(relativeError(condition.gradient,
+                          finiteDifferenceGradient<N>(value, element.positions, step)),
+            kTolerance);
+
+  const auto gradient = [&](const Positions<N>& x) -> Positions<N> {
+    return element.condition(x, false).gradient;
+  };
+  EXPECT_LE(relativeError(condition.hessian,
+                          finiteDifferenceJacobian<N>(gradient, element.positions, step)),
+            kTolerance);
+
+  EXPECT_LE((condition.hessian - condition.hessian.transpose()).norm(),
+            1e-12 * condition.hessian.norm());
+  EXPECT_EQ(element.condition(element.positions, false).gradient, condition.gradient);
+
+  const Real stiffness = 3.7;
+  const auto energy = [&](const Positions<N>& x) {
+    const Real c = element.condition(x, false).value;
+    return stiffness / 2 * c * c;
+  };
+  const ElementForces<N> forces = elementForces(condition, stiffness, 0, Positions<N>::Zero(),
+                                                StiffnessMode::Exact);
+  EXPECT_NEAR(forces.energy, energy(element.positions), 1e-15 * (1 + forces.energy));
+  EXPECT_LE(relativeError(-forces.force,
+                          finiteDifferenceGradient<N>(energy, element.positions, step)),
+            kTolerance);
+}
+
+/// With damping on and v fixed: Exact ∂f/∂x and ∂f/∂v against finite differences of the force.
+template <int N>
+void expectForceJacobiansMatchFiniteDifferences(const Case<N>& element, Random& random) {
+  SCOPED_TRACE(element.name);
+  const Real step = kRelativeStep * element.size;
+  const Real stiffness = 5.0, damping = 0.8;
+  Positions<N> velocities;
+  for (int i = 0; i < 3 * N; ++i) {
+    velocities[i] = random.uniform(-1, 1);
+  }
+  const ElementForces<N> forces =
+      elementForces(element.condition(element.positions, true), stiffness, damping, velocities,
+                    StiffnessMode::Exact);
+
+  const auto forceOfPositions = [&](const Positions<N>& x) -> Positions<N> {
+    return elementForces(element.condition(x, true), stiffness, damping, velocities,
+                         StiffnessMode::Exact)
+        .force;
+  };
+  EXPECT_LE(relativeError(forces.positionJacobian,
+                          finiteDifferenceJacobian<N>(forceOfPositions, element.positions, step)),
+            kTolerance);
+
+  const Condition<N> condition = element.condition(element.positions, true);
+  const auto forceOfVelocities = [&](const Positions<N>& v) -> Positions<N> {
+    return elementForces(condition, stiffness, damping, v, StiffnessMode::Exact).force;
+  };
+  EXPECT_LE(relativeError(forces.velocityJacobian,
+                          finiteDifferenceJacobian<N>(forceOfVelocities, velocities, 1e-6)),
+            kTolerance);
+}
+
+/// Internal forces (elastic + damping) have zero sum and zero torque about the origin.
+template <int N>
+void expectMomentumConserved(const Case<N>& element, Random& random) {
+  SCOPED_TRACE(element.name);
+  Positions<N> velocities;
+  for (int i = 0; i < 3 * N; ++i) {
+    velocities[i] = random.uniform(-1, 1);
+  }
+  const ElementForces<N> forces = elementForces(element.condition(element.positions, false), 4.0,
+                                                0.5, velocities, StiffnessMode::Exact);
+  Vec3 total = Vec3::Zero(), torque = Vec3::Zero();
+  Real forceScale = 0, torqueScale = 0;
+  for (int i = 0; i < N; ++i) {
+    const Vec3 x = element.positions.template segment<3>(3 * i);
+    const Vec3 f = forces.force.template segment<3>(3 * i);
+    total += f;
+    torque += x.cross(f);
+    forceScale += f.norm();
+    torqueScale += x.norm() * f.norm();
+  }
+  ASSERT_GT(forceScale, 0) << "a test element with no force checks nothing";
+  EXPECT_LE(total.norm(), 1e-12 * forceScale);
+  EXPECT_LE(torque.norm(), 1e-12 * torqueScale);
+}
+
+/// C, and so the energy, is unchanged by a rigid rotation plus translation.
+template <int N>
+void expectRigidMotionInvariance(const Case<N>& element, Random& random) {
+  SCOPED_TRACE(element.name);
+  const Mat3 rotation = random.rotation();
+  const Vec3 translation = random.vector(3);
+  Positions<N> moved;
+  for (int i = 0; i < N; ++i) {
+    moved.template segment<3>(3 * i) =
+        rotation * element.positions.template segment<3>(3 * i) + translation;
+  }
+  const Real before = element.condition(element.positions, false).value;
+  const Real after = element.condition(moved, false).value;
+  // C is accurate to rounding of the positions (~1e-12 absolute here, since a near-flat angle
+  // is small but not relatively precise) on top of a 1e-10 relative error.
+  const Real valueTolerance = 1e-10 * std::abs(before) + 1e-12;
+  EXPECT_NEAR(after, before, valueTolerance);
+  const Real stiffness = 2.5;
+  EXPECT_NEAR(stiffness / 2 * after * after, stiffness / 2 * before * before,
+              stiffness * (std::abs(before) + valueTolerance) * valueTolerance);
+}
+
+/// Smallest eigenvalue of a symmetric matrix relative to the largest magnitude.
+template <int Dofs>
+Real relativeSmallestEigenvalue(const Eigen::Matrix<Real, Dofs, Dofs>& matrix) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<Real, Dofs, Dofs>> solver(matrix);
+  const auto& eigenvalues = solver.eigenvalues();  // ascending
+  const Real largest = std::max(std::abs(eigenvalues[0]), std::abs(eigenvalues[Dofs - 1]));
+  return largest > 0 ? eigenvalues[0] / largest : 0;
+}
+
+/// Definite mode: −∂f/∂x symmetric positive semi-definite, with damping on and moving vertices.
+template <int N>
+void expectDefiniteModeSemiDefinite(const std::string& name,
+                                    const std::vector<Condition<N>>& conditions,
+                                    Random& random) {
+  SCOPED_TRACE(name);
+  Positions<N> velocities;
+  for (int i = 0; i < 3 * N; ++i) {
+    velocities[i] = random.uniform(-1, 1);
+  }
+  ElementForces<N> forces;
+  for (const Condition<N>& condition : conditions) {
+    accumulateConditionForces(condition, 7.0, 0.9, velocities, StiffnessMode::Definite, true,
+                              forces);
+  }
+  const Eigen::Matrix<Real, 3 * N, 3 * N> stiffness = -forces.positionJacobian;
+  ASSERT_GT(stiffness.norm(), 0);
+  EXPECT_EQ(stiffness, stiffness.transpose());
+  EXPECT_GE(relativeSmallestEigenvalue<3 * N>(stiffness), -1e-9);
+  EXPECT_GE(relativeSmallestEigenvalue<3 * N>(-forces.velocityJacobian), -1e-9);
+}
+
+/// Exact mode (no damping, so the matrix is symmetric) is clearly indefinite.
+template <int N>
+Real exactModeRelativeSmallestEigenvalue(const Condition<N>& condition) {
+  const ElementForces<N> forces =
+      elementForces(condition, 7.0, 0, Positions<N>::Zero(), StiffnessMode::Exact);
+  const Eigen::Matrix<Real, 3 * N, 3 * N> stiffness = -forces.positionJacobian;
+  return relativeSmallestEigenvalue<3 * N>((stiffness + stiffness.transpose()) / 2);
+}
+
+template <int N>
+bool allFinite(const Condition<N>& condition) {
+  return std::isfinite(condition.value) && condition.gradient.allFinite() &&
+         condition.hessian.allFinite();
+}
+
+template <int N>
+bool allFinite(const ElementForces<N>& forces) {
+  return std::isfinite(forces.energy) && forces.force.allFinite() &&
+         forces.positionJacobian.allFinite() && forces.velocityJacobian.allFinite();
+}
+
+/// The condition and its forces in both modes are finite.
+template <int N>
+void expectFinite(const std::string& name, const Condition<N>& condition) {
+  SCOPED_TRACE(name);
+  EXPECT_TRUE(allFinite(condition));
+  const Positions<N> velocities = Positions<N>::Constant(0.3);
+  for (StiffnessMode mode : {StiffnessMode::Exact, StiffnessMode::Definite}) {
+    EXPECT_TRUE(allFinite(elementForces(condition, 10.0, 1.0, velocities, mode)));
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// makeTriangleRest
+
+TEST(MakeTriangleRest, RightTriangleHasExpectedWeightsAndArea) {
+  // u along x, v along y; legs 2 m (warp) and 1 m (weft).
+  const TriangleRest rest = makeTriangleRest({4, 5, 6}, Vec2(0, 0), Vec2(2, 0), Vec2(0, 1));
+  EXPECT_EQ(rest.vertices, (std::array<Index, 3>{4, 5, 6}));
+  EXPECT_DOUBLE_EQ(rest.area, 1.0);
+  EXPECT_DOUBLE_EQ(rest.warpWeights[0], -0.5);
+  EXPECT_DOUBLE_EQ(rest.warpWeights[1], 0.5);
+  EXPECT_DOUBLE_EQ(rest.warpWeights[2], 0.0);
+  EXPECT_DOUBLE_EQ(rest.weftWeights[0], -1.0);
+  EXPECT_DOUBLE_EQ(rest.weftWeights[1], 0.0);
+  EXPECT_DOUBLE_EQ(rest.weftWeights[2], 1.0);
+
+  // The identity map x = (u, v, 0) has w_u = (1, 0, 0) and w_v = (0, 1, 0).
+  const Vec3 x0(0, 0, 0), x1(2, 0, 0), x2(0, 1, 0);
+  const Vec3 warp = rest.warpWeights[0] * x0 + rest.warpWeights[1] * x1 + rest.warpWeights[2] * x2;
+  const Vec3 weft = rest.weftWeights[0] * x0 + rest.weftWeights[1] * x1 + rest.weftWeights[2] * x2;
+  EXPECT_EQ(warp, Vec3(1, 0, 0));
+  EXPECT_EQ(weft, Vec3(0, 1, 0));
+}
+
+TEST(MakeTriangleRest, ClockwiseTriangleHasPositiveArea) {
+  const TriangleRest rest = makeTriangleRest({0, 1, 2}, Vec2(0, 0), Vec2(0, 1), Vec2(2, 0));
+  EXPECT_DOUBLE_EQ(rest.area, 1.0);
+}
+
+TEST(MakeTriangleRest, WeightsRecoverAnyAffineDeformationGradient) {
+  Random random(3);
+  for (int trial = 0; trial < 10; ++trial) {
+    const auto uv = randomMaterialTriangle(random, random.uniform(0.01, 2));
+    Eigen::Matrix<Real, 3, 2> deformation;
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 2; ++j) {
+        deformation(i, j) = random.uniform(-2, 2);
+      }
+    }
+    const Vec3 translation = random.vector(5);
+    const TriangleRest rest = makeTriangleRest({0, 1, 2}, uv[0], uv[1], uv[2]);
+    Vec3 warp = Vec3::Zero(), weft = Vec3::Zero();
+    for (int i = 0; i < 3; ++i) {
+      const Vec3 x = deformation * uv[i] + translation;
+      warp += rest.warpWeights[i] * x;
+      weft += rest.weftWeights[i] * x;
+    }
+    EXPECT_LE((warp - deformation.col(0)).norm(), 1e-12 * deformation.norm());
+    EXPECT_LE((weft - deformation.col(1)).norm(), 1e-12 * deformation.norm());
+    const Vec2 d1 = uv[1] - uv[0], d2 = uv[2] - uv[0];
+    EXPECT_NEAR(rest.area, std::abs(d1.x() * d2.y() - d1.y() * d2.x()) / 2, 1e-15);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dihedral angle and hinge scale
+
+TEST(DihedralAngle, SignedAngleFollowsTheHingeConvention) {
+  // Edge x0 -> x1 along +x, A in z = 0 with n_A = +z; B folds about the edge.
+  const Vec3 x0(0, 0, 0), x1(1, 0, 0), x2(0.3, 0.8, 0);
+  const auto fold = [](Real angle) { return Vec3(0.6, -0.7 * std::cos(angle), 0.7 * std::sin(angle)); };
+  EXPECT_EQ(dihedralAngle(x0, x1, x2, Vec3(0.6, -0.7, 0)), 0.0);
+  for (Real angle : {1e-6, 0.3, 1.2, 2.5, kPi - 1e-6}) {
+    // Positive when B folds towards A's normal, negative when it folds away.
+    EXPECT_NEAR(dihedralAngle(x0, x1, x2, fold(angle)), angle, 1e-12);
+    EXPECT_NEAR(dihedralAngle(x0, x1, x2, fold(-angle)), -angle, 1e-12);
+  }
+  // Folded flat onto A: +π, never −π.
+  EXPECT_EQ(dihedralAngle(x0, x1, x2, Vec3(0.6, 0.7, 0)), kPi);
+  EXPECT_EQ(dihedralAngle(x0, x1, x2, Vec3(0.6, 0.7, -0.0)), kPi);
+  // Swapping the roles of A and B (and reversing the edge) keeps the angle.
+  EXPECT_NEAR(dihedralAngle(x1, x0, fold(0.8), x2), 0.8, 1e-12);
+}
+
+TEST(DihedralAngle, IndependentOfTriangleShapeAndScale) {
+  const Vec3 x0(0, 0, 0), x1(3, 0, 0);
+  for (Real scale : {1e-3, 1.0, 50.0}) {
+    const Vec3 x2 = scale * Vec3(-2.0, 0.1, 0);
+    const Vec3 x3 = scale * Vec3(5.0, -4.0 * std::cos(0.7), 4.0 * std::sin(0.7));
+    EXPECT_NEAR(dihedralAngle(scale * x0, scale * x1, x2, x3), 0.7, 1e-12);
+  }
+}
+
+TEST(HingeStiffnessScale, IsThreeLengthSquaredOverAreaSum) {
+  EXPECT_DOUBLE_EQ(hingeStiffnessScale(2.0, 1.0, 3.0), 3.0);
+  EXPECT_DOUBLE_EQ(hingeStiffnessScale(0.05, 0.00125, 0.00125), 3.0);
+  EXPECT_EQ(hingeStiffnessScale(1.0, 0.0, 0.0), 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Derivatives
+
+TEST(ForceKernels, StretchAndShearDerivativesMatchFiniteDifferences) {
+  for (const Case<3>& element : triangleCases()) {
+    expectDerivativesMatchFiniteDifferences(element);
+  }
+}
+
+TEST(ForceKernels, BendDerivativesMatchFiniteDifferences) {
+  for (const Case<4>& element : hingeCases()) {
+    expectDerivativesMatchFiniteDifferences(element);
+  }
+}
+
+TEST(ForceKernels, SpringDerivativesMatchFiniteDifferences) {
+  for (const Case<2>& element : springCases()) {
+    expectDerivativesMatchFiniteDifferences(element);
+  }
+}
+
+TEST(ForceKernels, DampedForceJacobiansMatchFiniteDifferences) {
+  Random random(17);
+  for (const Case<3>& element : triangleCases()) {
+    expectForceJacobiansMatchFiniteDifferences(element, random);
+  }
+  for (const Case<4>& element : hingeCases()) {
+    expectForceJacobiansMatchFiniteDifferences(element, random);
+  }
+  for (const Case<2>& element : springCases()) {
+    expectForceJacobiansMatchFiniteDifferences(element, random);
+  }
+}
+
+TEST(ForceKernels, BendConditionIsScaledWrappedAngle) {
+  Random random(19);
+  const Positions<4> flat = hingePositions(random, 0, 0.05, 0);
+  for (Real restAngle : {0.0, 0.6, -2.0, kPi - 0.1}) {
+    const Hinge hinge = hingeFor(flat, restAngle);
+    ASSERT_GT(hinge.stiffnessScale, 0);
+    for (Real angle : {0.4, -1.1, 3.0, -3.0}) {
+      const Positions<4> x = hingePositions(random, angle, 0.05, 0);
+      Real expected = angle - restAngle;
+      expected = expected > kPi ? expected - 2 * kPi : expected <= -kPi ? expected + 2 * kPi : expected;
+      EXPECT_NEAR(bendConditionOf(hinge)(x, false).value, std::sqrt(hinge.stiffnessScale) * expected,
+                  1e-10);
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Physical invariants
+
+TEST(ForceKernels, RestPoseHasZeroEnergyAndForce) {
+  Random random(23);
+  const auto expectAtRest = [](const std::string& name, const auto& condition) {
+    SCOPED_TRACE(name);
+    constexpr int kN = std::decay_t<decltype(condition)>::kVertexCount;
+    const auto forces = elementForces(condition, 100.0, 1.0, Positions<kN>::Zero(),
+                                      StiffnessMode::Exact);
+    EXPECT_NEAR(condition.value, 0, 1e-12);
+    EXPECT_LE(forces.energy, 1e-20);
+    EXPECT_LE(forces.force.norm(), 1e-10);
+  };
+
+  for (Real size : {1.0, 0.05}) {
+    // Stretch and shear: the material triangle rigidly placed in space, b_u = b_v = 1.
+    const TriangleSetup setup =
+        placeTriangle(randomMaterialTriangle(random, size), planarDeformation(1, 0, 0, 1),
+                      random.rotation(), random.vector(2), random, 0, size);
+    const auto& x = setup.positions;
+    const StretchConditions stretch = stretchConditions(x.segment<3>(0), x.segment<3>(3),
+                                                        x.segment<3>(6), setup.rest, 1, 1, true);
+    expectAtRest("warp", stretch.warp);
+    expectAtRest("weft", stretch.weft);
+    expectAtRest("shear", shearCondition(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6),
+                                         setup.rest, true));
+
+    // Bend: flat with θ_rest = 0, and curved rest hinges at their rest angle.
+    for (Real restAngle : {0.0, 0.8, -1.9, kPi - 0.01}) {
+      const Positions<4> hinge = hingePositions(random, restAngle, size, 0);
+      expectAtRest("bend rest " + std::to_string(restAngle),
+                   bendConditionOf(hingeFor(hinge, restAngle))(hinge, true));
+    }
+
+    // Spring at its rest length.
+    const Vec3 x0 = random.vector(2);
+    expectAtRest("spring", springCondition(x0, x0 + size * (random.rotation() * Vec3::UnitX()),
+                                           size, true));
+  }
+}
+
+TEST(ForceKernels, StretchAndShearEnergyIsAreaTimesEnergyDensity) {
+  // Uniform deformation w_u = (s_u, 0, 0), w_v = (γ, s_v, 0): E = k a/2 (|w| − b)² per condition,
+  // so k is in N/m and the energy of a sheet does not depend on how finely it is meshed.
+  const Real stiffness = 260.0;
+  const Real su = 1.1, sv = 0.95, gamma = 0.2;
+  for (Real size : {1.0, 0.05}) {
+    const TriangleRest rest = makeTriangleRest({0, 1, 2}, Vec2(0, 0), Vec2(size, 0), Vec2(0, size));
+    const Vec3 x0(0, 0, 0), x1(su * size, 0, 0), x2(gamma * size, sv * size, 0);
+    const StretchConditions stretch = stretchConditions(x0, x1, x2, rest, 1, 1, false);
+    const Condition<3> shear = shearCondition(x0, x1, x2, rest, false);
+    ElementForces<3> forces;
+    for (const Condition<3>* condition : {&stretch.warp, &stretch.weft, &shear}) {
+      accumulateConditionForces(*condition, stiffness, 0, Positions<3>::Zero(),
+                                StiffnessMode::Definite, false, forces);
+    }
+    const Real area = size * size / 2;
+    const Real weftStretch = std::hypot(gamma, sv);
+    const Real expected = stiffness * area / 2 *
+                          ((su - 1) * (su - 1) + (weftStretch - 1) * (weftStretch - 1) +
+                           (su * gamma) * (su * gamma));
+    EXPECT_NEAR(forces.energy, expected, 1e-12 * expected) << "size " << size;
+  }
+}
+
+TEST(ForceKernels, EnergyInvariantUnderRigidMotion) {
+  Random random(29);
+  for (const Case<3>& element : triangleCases()) {
+    expectRigidMotionInvariance(element, random);
+  }
+  for (const Case<4>& element : hingeCases()) {
+    expectRigidMotionInvariance(element, random);
+  }
+  for (const Case<2>& element : springCases()) {
+    expectRigidMotionInvariance(element, random);
+  }
+}
+
+TEST(ForceKernels, InternalForcesConserveLinearAndAngularMomentum) {
+  Random random(31);
+  for (const Case<3>& element : triangleCases()) {
+    expectMomentumConserved(element, random);
+  }
+  for (const Case<4>& element : hingeCases()) {
+    expectMomentumConserved(element, random);
+  }
+  for (const Case<2>& element : springCases()) {
+    expectMomentumConserved(element, random);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Stiffness modes
+
+TEST(ForceKernels, DefiniteModeIsPositiveSemiDefinite) {
+  Random random(37);
+  const auto uv = randomMaterialTriangle(random, 0.05);
+  // Compressed, stretched, sheared, anisotropic, and bent out of plane with noise.
+  const std::vector<std::pair<std::string, Eigen::Matrix<Real, 3, 2>>> deformations = {
+      {"compressed", planarDeformation(0.6, 0, 0, 0.7)},
+      {"stretched", planarDeformation(1.3, 0, 0, 1.2)},
+      {"sheared", planarDeformation(1, 0.6, 0.1, 1)},
+      {"warp stretched, weft compressed", planarDeformation(1.2, 0, 0, 0.5)},
+  };
+  for (const auto& [name, deformation] : deformations) {
+    const TriangleSetup setup =
+        placeTriangle(uv, deformation, random.rotation(), random.vector(1), random, 0.05, 0.05);
+    const auto& x = setup.positions;
+    const StretchConditions stretch = stretchConditions(
+        x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), setup.rest, 1, 1, true);
+    const Condition<3> shear =
+        shearCondition(x.segment<3>(0), x.segment<3>(3), x.segment<3>(6), setup.rest, true);
+    expectDefiniteModeSemiDefinite<3>(name + " warp", {stretch.warp}, random);
+    expectDefiniteModeSemiDefinite<3>(name + " weft", {stretch.weft}, random);
+    expectDefiniteModeSemiDefinite<3>(name + " shear", {shear}, random);
+    expectDefiniteModeSemiDefinite<3>(name + " triangle", {stretch.warp, stretch.weft, shear},
+                                      random);
+  }
+  for (Real angle : {0.3, 1.5, -2.5, kPi - 1e-3}) {
+    const Positions<4> x = hingePositions(random, angle, 0.05, 0.05);
+    expectDefiniteModeSemiDefinite<4>("folded " + std::to_string(angle),
+                                      {bendConditionOf(hingeFor(x, 0))(x, true)}, random);
+  }
+  for (const Case<2>& element : springCases()) {
+    expectDefiniteModeSemiDefinite<2>(element.name, {element.condition(element.positions, true)},
+                                      random);
+  }
+}
+
+TEST(ForceKernels, ExactModeIsIndefiniteWhereDefiniteModeIsNot) {
+  Random random(41);
+  // Compressed stretch: −k C ∇²C with C < 0 is negative across the fibre.
+  const auto uv = randomMaterialTriangle(random, 0.05);
+  const TriangleSetup compressed = placeTriangle(uv, planarDeformation(0.6, 0, 0, 0.7),
+                                                 random.rotation(), random.vector(1), random, 0, 0.05);
+  const auto& x = compressed.positions;
+  const StretchConditions stretch = stretchConditions(x.segment<3>(0), x.segment<3>(3),
+                                                      x.segment<3>(6), compressed.rest, 1, 1, true);
+  EXPECT_LT(exactModeRelativeSmallestEigenvalue(stretch.warp), -1e-3);
+
+  // Sheared triangle: the shear Hessian is a saddle.
+  const TriangleSetup sheared = placeTriangle(uv, planarDeformation(1, 0.6, 0, 1),
+                                              random.rotation(), random.vector(1), random, 0, 0.05);
+  const auto& y = sheared.positions;
+  EXPECT_LT(exactModeRelativeSmallestEigenvalue(
+                shearCondition(y.segment<3>(0), y.segment<3>(3), y.segment<3>(6), sheared.rest, true)),
+            -1e-3);
+
+  // Strongly folded hinge.
+  const Positions<4> folded = hingePositions(random, 2.0, 0.05, 0);
+  EXPECT_LT(exactModeRelativeSmallestEigenvalue(bendConditionOf(hingeFor(folded, 0))(folded, true)),
+            -1e-3);
+
+  // Compressed spring.
+  EXPECT_LT(exactModeRelativeSmallestEigenvalue(
+                springCondition(Vec3(0, 0, 0), Vec3(0.5, 0, 0), 1.0, true)),
+            -1e-3);
+}
+
+TEST(ForceKernels, DefiniteModeKeepsStretchedGeometricStiffnessOnly) {
+  // A stretched spring keeps k C ∇²C (lateral stiffness); a compressed one drops it.
+  const Condition<2> stretched = springCondition(Vec3(0, 0, 0), Vec3(1.5, 0, 0), 1.0, true);
+  const Condition<2> compressed = springCondition(Vec3(0, 0, 0), Vec3(0.5, 0, 0), 1.0, true);
+  const auto lateral = [](const Condition<2>& condition, StiffnessMode mode) {
+    return -elementForces(condition, 10.0, 0, Positions<2>::Zero(), mode).positionJacobian(1, 1);
+  };
+  EXPECT_NEAR(lateral(stretched, StiffnessMode::Definite), 10.0 * 0.5 / 1.5, 1e-12);
+  EXPECT_EQ(lateral(stretched, StiffnessMode::Definite), lateral(stretched, StiffnessMode::Exact));
+  EXPECT_EQ(lateral(compressed, StiffnessMode::Definite), 0.0);
+  EXPECT_LT(lateral(compressed, StiffnessMode::Exact), 0.0);
+}
+
+TEST(ForceKernels, DampingActsOnRelativeVelocityAlongTheSpring) {
+  const Condition<2> spring = springCondition(Vec3(0, 0, 0), Vec3(2, 0, 0), 2.0, false);
+  Positions<2> velocities;
+  velocities << 0, 5, 0, 1, 7, 0;  // separating at 1 m/s along x; sideways motion is free
+  ElementForces<2> forces;
+  accumulateConditionForces(spring, 100.0, 3.0, velocities, StiffnessMode::Definite, false, forces);
+  Positions<2> expected;
+  expected << 3.0, 0, 0, -3.0, 0, 0;
+  EXPECT_LE((forces.force - expected).norm(), 1e-12);
+  EXPECT_EQ(forces.energy, 0.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Degenerate input
+
+TEST(ForceKernels, DegenerateInputGivesFiniteResults) {
+  const TriangleRest rest = makeTriangleRest({0, 1, 2}, Vec2(0, 0), Vec2(0.05, 0), Vec2(0, 0.05));
+  const Vec3 p(0.3, -0.2, 0.1);
+  const auto triangle = [&](const std::string& name, const Vec3& x0, const Vec3& x1,
+                            const Vec3& x2) {
+    const StretchConditions stretch = stretchConditions(x0, x1, x2, rest, 1, 1, true);
+    expectFinite(name + " warp", stretch.warp);
+    expectFinite(name + " weft", stretch.weft);
+    expectFinite(name + " shear", shearCondition(x0, x1, x2, rest, true));
+  };
+  triangle("collapsed to a point", p, p, p);
+  triangle("collinear", p, p + Vec3(0.05, 0, 0), p + Vec3(0.1, 0, 0));
+  triangle("warp collapsed", p, p, p + Vec3(0, 0.05, 0));
+  {
+    const StretchConditions stretch = stretchConditions(p, p, p, rest, 1, 1, true);
+    EXPECT_EQ(stretch.warp.gradient, Condition<3>::Gradient::Zero());
+    EXPECT_NEAR(stretch.warp.value, -std::sqrt(rest.area), 1e-15);
+  }
+
+  const Vec3 a(0, 0, 0), b(0.05, 0, 0), c(0.02, 0.04, 0), d(0.03, -0.04, 0.01);
+  Hinge hinge;
+  hinge.restAngle = 0.3;
+  hinge.stiffnessScale = 3.0;
+  const auto bend = [&](const std::string& name, const Vec3& x0, const Vec3& x1, const Vec3& x2,
+                        const Vec3& x3) {
+    const Condition<4> condition = bendCondition(x0, x1, x2, x3, hinge, true);
+    expectFinite(name, condition);
+    EXPECT_TRUE(std::isfinite(dihedralAngle(x0, x1, x2, x3))) << name;
+  };
+  bend("collapsed edge", a, a, c, d);
+  bend("A has zero area", a, b, Vec3(0.1, 0, 0), d);
+  bend("B has zero area", a, b, c, Vec3(-0.02, 0, 0));
+  bend("x3 on x0", a, b, c, a);
+  bend("all at one point", a, a, a, a);
+  bend("nearly collapsed edge", a, Vec3(1e-12, 0, 0), c, d);
+  bend("sliver A", a, b, Vec3(0.02, 1e-13, 0), d);
+  EXPECT_EQ(bendCondition(a, a, c, d, hinge, true).gradient, Condition<4>::Gradient::Zero());
+
+  expectFinite("spring collapsed", springCondition(p, p, 0.05, true));
+  expectFinite("zero-length spring collapsed", springCondition(p, p, 0, true));
+  expectFinite("zero-length spring, tiny extension",
+               springCondition(p, p + Vec3(1e-300, 0, 0), 0, true));
+}
+
+}  // namespace
+}  // namespace weft
