@@ -1,0 +1,282 @@
+// FilteredPcg: BW98 §5.3 modified PCG. See the design note in the header for the method, the
+// stopping rule and the determinism scheme; the kernels below are the per-range sweeps it runs.
+#include <solver/FilteredPcg.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace weft {
+
+namespace {
+
+// --- Kernels over a vertex range [begin, end). Each touches only its own vertices' entries of the
+// --- output arrays (reading neighbours only through the SpMV gather), and each dot product is
+// --- summed in vertex order, so a range gives the same bits whichever thread runs it.
+
+/// P̃_i⁻¹ of one vertex before the safety checks: the inverse of its diagonal block on the
+/// vertex's free subspace, zero on the constrained one (header, "Preconditioner").
+Mat3 filteredInverse(const Mat3& diagonal, const VertexFilter& filter, Index vertex) {
+  switch (filter.kind(vertex)) {
+    case ConstraintKind::Free:
+      return diagonal.inverse();
+    case ConstraintKind::OneDirection:
+    case ConstraintKind::TwoDirections: {
+      // S A S + (I − S) is A_ii on the free subspace and the identity on the constrained one, so
+      // it is invertible whenever A_ii is SPD; the outer S's zero the constrained part again.
+      const Mat3 projection = filter.projection(vertex);
+      const Mat3 restricted = projection * diagonal * projection + (Mat3::Identity() - projection);
+      return projection * restricted.inverse() * projection;
+    }
+    case ConstraintKind::Fixed:
+      break;
+  }
+  return Mat3::Zero();
+}
+
+/// P̃_i⁻¹ for every vertex of the range.
+void buildPreconditionerRange(Index begin, Index end, const BlockSparseMatrix& A,
+                              const VertexFilter& filter, std::vector<Mat3>& inverseDiagonal) {
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    const Mat3& diagonal = A.block(A.diagonalSlot(vertex));
+    Mat3 inverse = filteredInverse(diagonal, filter, vertex);
+    // A singular diagonal block (impossible for SPD A, possible for a broken assembly) gives an
+    // infinite inverse; fall back to scalar Jacobi so the preconditioner itself stays finite. A NaN
+    // block fails the test too, but its NaN still reaches the residual through the SpMV.
+    if (!inverse.allFinite()) {
+      const Real meanDiagonal = diagonal.trace() / 3;
+      inverse = (meanDiagonal > 0 && std::isfinite(meanDiagonal) ? 1 / meanDiagonal : Real(1)) *
+                filter.projection(vertex);
+    }
+    // Cofactor inverses of a symmetric block can differ from symmetric in the last bit; CG wants a
+    // symmetric preconditioner, so average the two triangles.
+    inverseDiagonal[vertex] = Real(0.5) * (inverse + inverse.transpose());
+  }
+}
+
+/// Δv = S·Δv + (I − S)z (warm) or Δv = (I − S)z (cold) over the range.
+void startRange(Index begin, Index end, const VertexFilter& filter, bool warmStart,
+                Vec3Array& deltaV) {
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    deltaV[vertex] = warmStart ? Vec3(filter.filter(vertex, deltaV[vertex]) + filter.target(vertex))
+                               : filter.target(vertex);
+  }
+}
+
+/// out = (I − S)z over the range; returns Σ ‖(I − S)z‖² (zero when no target moves anything).
+Real targetRange(Index begin, Index end, const VertexFilter& filter, Vec3Array& out) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    out[vertex] = filter.target(vertex);
+    sum += out[vertex].squaredNorm();
+  }
+  return sum;
+}
+
+/// r = S b, s = P̃⁻¹ r over the range; returns Σ rᵀs (the residual of a zero start).
+Real rightHandSideRange(Index begin, Index end, const Vec3Array& b, const VertexFilter& filter,
+                        const std::vector<Mat3>& inverseDiagonal, Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    r[vertex] = filter.filter(vertex, b[vertex]);
+    s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// r = S(b − A x), s = P̃⁻¹ r over the range; returns Σ rᵀs.
+Real residualRange(Index begin, Index end, const BlockSparseMatrix& A, const Vec3Array& b,
+                   const VertexFilter& filter, const std::vector<Mat3>& inverseDiagonal,
+                   const Vec3Array& x, Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    r[vertex] = filter.filter(vertex, b[vertex] - A.multiplyRow(vertex, x));
+    s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// c = s over the range (the first search direction; s is already filtered).
+void copyRange(Index begin, Index end, const Vec3Array& in, Vec3Array& out) {
+  std::copy(in.begin() + begin, in.begin() + end, out.begin() + begin);
+}
+
+/// q = S A c over the range (the SpMV); returns Σ cᵀq.
+Real filteredProductRange(Index begin, Index end, const BlockSparseMatrix& A,
+                          const VertexFilter& filter, const Vec3Array& c, Vec3Array& q) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    q[vertex] = filter.filter(vertex, A.multiplyRow(vertex, c));
+    sum += c[vertex].dot(q[vertex]);
+  }
+  return sum;
+}
+
+/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs.
+Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const Vec3Array& q,
+                 const std::vector<Mat3>& inverseDiagonal, Vec3Array& deltaV, Vec3Array& r,
+                 Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    deltaV[vertex] += alpha * c[vertex];
+    r[vertex] -= alpha * q[vertex];
+    s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// c = S(s + β c) over the range. s and c are in the free subspace already; filtering again
+/// removes the rounding that would otherwise let constrained components creep.
+void directionRange(Index begin, Index end, Real beta, const VertexFilter& filter,
+                    const Vec3Array& s, Vec3Array& c) {
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    c[vertex] = filter.filter(vertex, s[vertex] + beta * c[vertex]);
+  }
+}
+
+}  // namespace
+
+void FilteredPcg::resize(Index vertexCount) {
+  m_residual.assign(vertexCount, Vec3::Zero());
+  m_preconditioned.assign(vertexCount, Vec3::Zero());
+  m_direction.assign(vertexCount, Vec3::Zero());
+  m_product.assign(vertexCount, Vec3::Zero());
+  m_inverseDiagonal.assign(vertexCount, Mat3::Zero());
+  m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
+}
+
+template <typename Kernel>
+Real FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
+  const Index blockCount = (vertexCount + kReductionBlock - 1) / kReductionBlock;
+  // A parallel version runs this loop's bodies on any threads; the combine below stays serial.
+  for (Index block = 0; block < blockCount; ++block) {
+    const Index begin = block * kReductionBlock;
+    m_blockPartials[block] = kernel(begin, std::min(begin + kReductionBlock, vertexCount));
+  }
+  // Combine in block order: the one summation order, whatever the thread count.
+  Real sum = 0;
+  for (Index block = 0; block < blockCount; ++block) sum += m_blockPartials[block];
+  return sum;
+}
+
+template <typename Kernel>
+void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
+  for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
+    kernel(begin, std::min(begin + kReductionBlock, vertexCount));
+  }
+}
+
+SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
+                               const VertexFilter& filter, const PcgSettings& settings,
+                               Vec3Array& deltaV) {
+  SolveReport report;
+  const Index vertexCount = A.blockRows();
+  // Validated rather than asserted: the contract says a mismatch is reported, not undefined.
+  if (b.size() != vertexCount || filter.size() != vertexCount) {
+    report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
+    report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
+    return report;
+  }
+  if (m_residual.size() != vertexCount) resize(vertexCount);  // allocates only on a size change
+  bool warmStart = settings.warmStart;
+  if (deltaV.size() != vertexCount) {
+    deltaV.assign(vertexCount, Vec3::Zero());
+    warmStart = false;
+  }
+
+  Vec3Array& r = m_residual;
+  Vec3Array& s = m_preconditioned;
+  Vec3Array& c = m_direction;
+  Vec3Array& q = m_product;
+
+  forEachBlock(vertexCount, [&](Index begin, Index end) {
+    buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
+  });
+
+  // The reference r_ref = S(b − A(I − S)z). A cold start begins exactly there, so it is the initial
+  // residual; a warm start needs it separately, and needs the SpMV only when some target is nonzero.
+  Real referenceDelta = 0;
+  if (warmStart) {
+    const Real targetSquaredNorm = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return targetRange(begin, end, filter, c);
+    });
+    referenceDelta =
+        targetSquaredNorm == 0
+            ? sumOverBlocks(vertexCount,
+                            [&](Index begin, Index end) {
+                              return rightHandSideRange(begin, end, b, filter, m_inverseDiagonal,
+                                                        r, s);
+                            })
+            : sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+                return residualRange(begin, end, A, b, filter, m_inverseDiagonal, c, r, s);
+              });
+  }
+
+  forEachBlock(vertexCount,
+               [&](Index begin, Index end) { startRange(begin, end, filter, warmStart, deltaV); });
+  Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return residualRange(begin, end, A, b, filter, m_inverseDiagonal, deltaV, r, s);
+  });
+  if (!warmStart) referenceDelta = delta;
+
+  // rᵀP̃⁻¹r ≥ 0 in exact arithmetic; clamp rounding below zero before the square root.
+  const Real referenceNorm = std::sqrt(std::max(referenceDelta, Real(0)));
+  const Real threshold = std::max(settings.tolerance * referenceNorm, settings.absoluteTolerance);
+  const Real denominator = std::max(referenceNorm, settings.absoluteTolerance);
+  const bool referenceFinite = std::isfinite(referenceDelta);
+
+  forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
+
+  Real previousDelta = delta;
+  for (;;) {
+    // NaN compares false with everything, so test finiteness first: a NaN residual must end the
+    // loop as a failure, never look converged and never spin until the cap.
+    if (!referenceFinite || !std::isfinite(delta)) {
+      report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
+      report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
+      report.converged = false;
+      break;
+    }
+    report.residualNorm = std::sqrt(std::max(delta, Real(0)));
+    // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
+    report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
+                              : report.residualNorm == 0 ? Real(0)
+                                                         : std::numeric_limits<Real>::infinity();
+    if (report.residualNorm <= threshold) {
+      report.converged = true;
+      break;
+    }
+    if (report.iterations >= settings.maxIterations) break;
+
+    if (report.iterations > 0) {
+      const Real beta = delta / previousDelta;
+      forEachBlock(vertexCount, [&](Index begin, Index end) {
+        directionRange(begin, end, beta, filter, s, c);
+      });
+    }
+    const Real curvature = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return filteredProductRange(begin, end, A, filter, c, q);
+    });
+    // cᵀAc ≤ 0 means A is not positive definite on the free subspace (or q holds a NaN): CG has
+    // broken down. Stop before touching Δv, so it keeps the last finite iterate.
+    if (!(curvature > 0) || !std::isfinite(curvature)) {
+      if (!std::isfinite(curvature)) {
+        report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
+        report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
+      }
+      break;
+    }
+    const Real alpha = delta / curvature;
+    previousDelta = delta;
+    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
+    });
+    ++report.iterations;
+  }
+  return report;
+}
+
+}  // namespace weft
