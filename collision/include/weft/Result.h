@@ -30,7 +30,9 @@ class [[nodiscard]] Result {
 
   const T& value() const& { assert(ok() && "Result::value() on an error; test ok() first"); return *m_value; }
   T& value() & { assert(ok() && "Result::value() on an error; test ok() first"); return *m_value; }
-  T&& value() && { assert(ok() && "Result::value() on an error; test ok() first"); return std::move(*m_value); }
+  /// On a temporary, the value is moved out and returned by value, so that
+  /// `for (auto& x : f().value())` does not iterate over a destroyed Result.
+  T value() && { assert(ok() && "Result::value() on an error; test ok() first"); return std::move(*m_value); }
 
   const T* operator->() const { return &value(); }
   T* operator->() { return &value(); }

@@ -1,0 +1,37 @@
+// The curtain runner: the frame loop of the main job (DESIGN.md §4, §8).
+//
+// It steps the curtain scene frame by frame, as a game would, timing each frame's simulation
+// (and rendering, when weft::render is built and --render is not off), and writes a report, a
+// JSON summary with the keys of DESIGN.md §8 and an optional per-frame CSV.
+#pragma once
+
+#include <weft/engine/SolverSettings.h>
+
+#include <cstdint>
+#include <iosfwd>
+#include <string>
+
+namespace weft {
+
+/// Command-line options of weft-curtain.
+struct CurtainRunOptions {
+  unsigned size = 1;               ///< 1, 4, 16 or 64
+  unsigned frames = 600;           ///< frames to run (600 = the full 10 s script)
+  unsigned threads = 0;            ///< worker threads (0 = all cores)
+  unsigned renderWidth = 1280;     ///< pixels; 0 = render off
+  unsigned renderHeight = 720;     ///< pixels
+  bool selfCollision = true;       ///< self-collision on (needs the collision module)
+  bool checkIntersections = false; ///< count intersecting triangle pairs every frame (untimed)
+  double budgetMs = 0;             ///< simulation budget per frame in ms; 0 = none
+  std::string captureDirectory;    ///< where PNG frames go; empty = no capture
+  std::string summaryJson;         ///< JSON summary path; empty = none
+  std::string frameCsv;            ///< per-frame CSV path; empty = none
+  IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< time integrator
+  bool progress = true;            ///< print a progress line every second of simulated time
+};
+
+/// Runs the curtain and prints the report to `out`. Returns a process exit code: 0 when the run
+/// completed with finite state, 1 otherwise (the report says why), 2 on bad options.
+int runCurtain(const CurtainRunOptions& options, std::ostream& out);
+
+}  // namespace weft

@@ -1,0 +1,61 @@
+// weft-curtain: command line of the curtain runner (flags of DESIGN.md §8).
+// CLI11 is included here and nowhere else: it costs ~12 s of compile time per file.
+#include "CurtainRunner.h"
+
+#include <CLI/CLI.hpp>
+
+#include <iostream>
+#include <map>
+
+int main(int argc, char** argv) {
+  weft::CurtainRunOptions options;
+  CLI::App app{"Weft curtain benchmark: simulate (and render) the curtain of DESIGN.md §4 and "
+               "report frame times"};
+  app.add_option("--size", options.size, "Refinement: 1, 4, 16 or 64 times 2,400 triangles")
+      ->check(CLI::IsMember({1u, 4u, 16u, 64u}));
+  app.add_option("--frames", options.frames, "Frames to run (600 = the 10 s script)")
+      ->check(CLI::Range(1u, 1000000u));
+  app.add_option("--threads", options.threads, "Worker threads (0 = all cores)");
+  std::string render = "1280x720";
+  app.add_option("--render", render, "Resolution WxH, or off");
+  std::string selfCollision = "on";
+  app.add_option("--self-collision", selfCollision, "on or off")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--capture", options.captureDirectory, "Directory for PNG frames");
+  app.add_flag("--check-intersections", options.checkIntersections,
+               "Count intersecting triangle pairs every frame (not timed)");
+  app.add_option("--budget-ms", options.budgetMs, "Simulation budget per frame in ms")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--summary-json", options.summaryJson, "Write the JSON summary here");
+  app.add_option("--csv", options.frameCsv, "Write per-frame statistics here (CSV)");
+  const std::map<std::string, weft::IntegratorKind> integrators{
+      {"implicit-euler", weft::IntegratorKind::ImplicitEuler},
+      {"explicit-euler", weft::IntegratorKind::ExplicitEuler},
+      {"symplectic-euler", weft::IntegratorKind::SymplecticEuler},
+      {"midpoint", weft::IntegratorKind::Midpoint},
+      {"rk4", weft::IntegratorKind::RungeKutta4}};
+  app.add_option("--integrator", options.integrator, "Time integrator")
+      ->transform(CLI::CheckedTransformer(integrators, CLI::ignore_case));
+  bool quiet = false;
+  app.add_flag("--quiet", quiet, "No progress lines");
+  CLI11_PARSE(app, argc, argv);
+
+  options.selfCollision = selfCollision == "on";
+  options.progress = !quiet;
+  if (render == "off") {
+    options.renderWidth = options.renderHeight = 0;
+  } else {
+    unsigned width = 0, height = 0;
+    char separator = 0;
+    std::istringstream text(render);
+    if (!(text >> width >> separator >> height) || separator != 'x' || width == 0 || height == 0 ||
+        width > 16384 || height > 16384) {
+      std::cerr << "weft-curtain: --render '" << render
+                << "' is not a resolution; give WIDTHxHEIGHT (e.g. 1280x720) or off\n";
+      return 2;
+    }
+    options.renderWidth = width;
+    options.renderHeight = height;
+  }
+  return weft::runCurtain(options, std::cout);
+}

@@ -1,0 +1,49 @@
+// Cloth materials in physical units, and the choice of force model.
+//
+// Stiffnesses are per unit width, so they do not change with mesh resolution:
+// stretch and shear in N/m (membrane stiffness: force per metre of cloth per unit strain),
+// bending in N·m (moment per metre of cloth per unit curvature). Damping acts on the rate of the
+// same strains (Baraff & Witkin 1998, §2.3): a stiffness k with damping k_d behaves like a
+// Rayleigh damper of time constant k_d / k.
+//
+// The defaults are the cotton-like curtain material of DESIGN.md §4.
+#pragma once
+
+#include <weft/Math.h>
+
+namespace weft {
+
+/// Continuum cloth material for the Baraff–Witkin model (and the mass to give every vertex).
+struct ClothMaterial {
+  Real arealDensity = 0.15;           ///< kg/m², mass per rest area; lumped to vertices
+  Real warpStretchStiffness = 260.0;  ///< N/m, resistance to stretching along the warp (u)
+  Real weftStretchStiffness = 260.0;  ///< N/m, resistance to stretching along the weft (v)
+  Real shearStiffness = 100.0;        ///< N/m, resistance to in-plane shear (angle change of u, v)
+  Real bendingStiffness = 2.3e-6;     ///< N·m, resistance to curvature; 0 turns bending off
+  Real warpRestScale = 1.0;           ///< rest length factor along the warp (<1 pre-tensions)
+  Real weftRestScale = 1.0;           ///< rest length factor along the weft (<1 pre-tensions)
+  Real stretchDamping = 0.5;          ///< N·s/m, damps the stretch rate (≈ 2 ms Rayleigh time)
+  Real shearDamping = 0.2;            ///< N·s/m, damps the shear rate
+  Real bendingDamping = 5e-9;         ///< N·m·s, damps the bending rate
+  Real airDrag = 0.1;                 ///< N·s/m³, linear drag per area on velocity relative to air
+  Real thickness = 0.003;             ///< m, contact thickness (collision)
+  Real friction = 0.3;                ///< Coulomb friction coefficient (collision)
+};
+
+/// The classic mass-spring network (Provot 1995): one stiffness per spring family.
+struct MassSpringMaterial {
+  Real structuralStiffness = 260.0;  ///< N/m per spring, along warp and weft
+  Real shearStiffness = 100.0;       ///< N/m per spring, along diagonals
+  Real flexionStiffness = 2.0;       ///< N/m per spring, skip-one springs that resist bending
+  Real structuralDamping = 0.5;      ///< N·s/m per spring, on the spring's length rate
+  Real shearDamping = 0.2;           ///< N·s/m per spring
+  Real flexionDamping = 0.004;       ///< N·s/m per spring
+};
+
+/// Which internal forces a cloth uses.
+enum class ForceModel {
+  BaraffWitkin,  ///< continuum stretch, shear and dihedral bending (the default)
+  MassSpring,    ///< structural, shear and flexion springs
+};
+
+}  // namespace weft

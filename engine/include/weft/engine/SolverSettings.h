@@ -1,0 +1,37 @@
+// How a cloth is advanced in time: the integrator, its substeps, and the linear solver.
+#pragma once
+
+#include <weft/Math.h>
+
+namespace weft {
+
+/// The time integrators every cloth can use.
+enum class IntegratorKind {
+  ExplicitEuler,    ///< x += h v, v += h a(x, v): first order, needs tiny steps on stiff cloth
+  SymplecticEuler,  ///< v += h a(x, v), x += h v_new: first order, stable for h ω < 2
+  Midpoint,         ///< explicit midpoint (RK2): second order
+  RungeKutta4,      ///< classic RK4: fourth order, stable for h ω < 2.78
+  ImplicitEuler,    ///< backward Euler, linearised as in Baraff & Witkin 1998 (the default)
+};
+
+/// Readable name of an integrator ("implicit-euler", "rk4", ...).
+const char* integratorName(IntegratorKind kind);
+
+/// Integrator, substeps and solver settings of one cloth.
+struct SolverSettings {
+  IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< which integrator
+  /// Substeps per frame; 0 = automatic: implicit takes enough that h ≤ maxImplicitStep, explicit
+  /// methods take enough that the stiffest mode of the rest state is stable.
+  Index substeps = 0;
+  Real maxImplicitStep = 1.0 / 60.0;  ///< s, largest implicit substep in automatic mode
+  /// Cap on automatic substeps per frame; an explicit method that would need more is stepped at
+  /// the cap and reported unstable (StepStatus::Unstable), never silently.
+  Index maxSubsteps = 4000;
+  /// Extra Newton iterations after Baraff–Witkin's single linearised solve (0 = BW98 exactly).
+  int newtonIterations = 0;
+  Real cgTolerance = 1e-3;  ///< relative residual at which the PCG stops (preconditioned norm)
+  int cgMaxIterations = 200;  ///< PCG iteration cap per solve
+  bool warmStart = true;      ///< start each PCG from the previous step's Δv
+};
+
+}  // namespace weft

@@ -1,0 +1,55 @@
+// What a World::step() did: status flags that name the knob to turn, and per-frame statistics.
+#pragma once
+
+#include <weft/Math.h>
+
+#include <cstdint>
+#include <string>
+
+namespace weft {
+
+/// Bit flags returned by World::step(). Ok (0) means nothing to report.
+enum class StepStatus : std::uint32_t {
+  Ok = 0,
+  /// An explicit integrator needed more substeps than SolverSettings::maxSubsteps to stay stable,
+  /// or the motion diverged: raise maxSubsteps, lower stiffness, or use ImplicitEuler.
+  Unstable = 1u << 0,
+  /// A PCG solve stopped at cgMaxIterations before cgTolerance: raise cgMaxIterations or
+  /// cgTolerance, or take smaller steps.
+  SolverNotConverged = 1u << 1,
+  /// The state became non-finite; the cloth was restored to its state before the frame.
+  RolledBack = 1u << 2,
+  /// The step was refused (bad frameDt); nothing changed.
+  InvalidInput = 1u << 3,
+};
+
+constexpr StepStatus operator|(StepStatus a, StepStatus b) {
+  return StepStatus(std::uint32_t(a) | std::uint32_t(b));
+}
+constexpr StepStatus& operator|=(StepStatus& a, StepStatus b) { return a = a | b; }
+/// True when `flags` holds `flag`.
+constexpr bool hasFlag(StepStatus flags, StepStatus flag) {
+  return (std::uint32_t(flags) & std::uint32_t(flag)) != 0;
+}
+/// "ok", or the set flags joined by '|', e.g. "unstable|solver-not-converged".
+std::string describe(StepStatus status);
+
+/// Statistics of the last frame, summed over cloths and substeps (Box2D b2Profile in spirit).
+struct StepStats {
+  std::uint64_t frame = 0;     ///< frames stepped so far, this one included
+  Real simulatedTime = 0;      ///< s, world time at the end of the frame
+  Real stepMs = 0;             ///< ms of wall-clock time in step()
+  Index substeps = 0;          ///< substeps taken (largest over cloths)
+  int linearSolves = 0;        ///< PCG solves
+  int cgIterations = 0;        ///< PCG iterations summed over solves
+  Real cgResidual = 0;         ///< relative residual of the last solve
+  /// Largest stretch l / l_rest − 1 over mesh edges at the end (compression, which cloth turns
+  /// into folds, does not count).
+  Real maxStrain = 0;
+  Real kineticEnergy = 0;      ///< J at the end of the frame
+  Real potentialEnergy = 0;    ///< J (elastic + gravity) at the start of the last substep
+  Real maxSpeed = 0;           ///< m/s, fastest vertex at the end
+  StepStatus status = StepStatus::Ok;  ///< the flags step() returned
+};
+
+}  // namespace weft

@@ -1,0 +1,96 @@
+// Cloth: one simulated instance of a ClothModel — its state, forces, pins and integrator.
+//
+// It is the DynamicSystem the integrators advance. Pins move linearly over a frame, from the
+// targets of the previous frame (pinStart) to the targets set for this one (pinEnd); every stage
+// of every integrator sees the pins where they are at that stage's time.
+#pragma once
+
+#include "ClothForces.h"
+#include "integrators/Integrator.h"
+#include "solver/BlockSparseMatrix.h"
+
+#include <weft/engine/World.h>
+
+#include <memory>
+
+namespace weft {
+
+/// Result of advancing one cloth by one frame.
+struct ClothFrameReport {
+  Index substeps = 0;
+  IntegratorReport integrator;
+  StepStatus status = StepStatus::Ok;
+};
+
+class Cloth final : public DynamicSystem {
+ public:
+  /// Validates settings; the error names the field and the fix.
+  static Result<std::unique_ptr<Cloth>> create(std::shared_ptr<const ClothModel> model,
+                                               const ClothSettings& settings,
+                                               const WorldSettings& world);
+
+  // DynamicSystem
+  Index vertexCount() const override { return m_model->vertexCount(); }
+  const std::vector<Real>& masses() const override { return m_forces.masses(); }
+  Real computeForces(const Vec3Array& x, const Vec3Array& v, Real t, Vec3Array& f) override;
+  Real linearize(const Vec3Array& x, const Vec3Array& v, Real t, Real h, Vec3Array& f,
+                 const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) override;
+  const BlockSparseMatrix& systemMatrix() const override { return m_matrix; }
+  std::span<const Index> prescribedVertices() const override { return m_pinnedSorted; }
+  void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const override;
+
+  /// Advances by one frame of length frameDt starting at world time t.
+  ClothFrameReport stepFrame(Real t, Real frameDt);
+  /// Substeps this cloth takes for a frame of frameDt; `predictedUnstable` is set when an
+  /// explicit method would need more than maxSubsteps.
+  Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
+
+  Status setPinTargets(std::span<const Vec3> targets);
+  const Vec3Array& pinTargets() const { return m_pinEnd; }
+
+  const Vec3Array& positions() const { return m_positions; }
+  const Vec3Array& velocities() const { return m_velocities; }
+  const Vec3Array& normals();  ///< recomputed on demand after a step
+  const ClothModel& model() const { return *m_model; }
+  const ClothSettings& settings() const { return m_settings; }
+
+  Status setState(std::span<const Vec3> positions, std::span<const Vec3> velocities);
+  /// Largest stretch l / l_rest − 1 over mesh edges (0 when nothing is stretched).
+  Real maxStrain() const;
+  /// J, Σ ½ m v².
+  Real kineticEnergy() const;
+  /// m/s, largest vertex speed.
+  Real maxSpeed() const;
+  /// Upper bound (Gershgorin, rest state, pins excluded) of the fastest free mode: ω in rad/s
+  /// and its damping rate in 1/s. Used to choose explicit substeps.
+  Real stiffestFrequency() const { return m_stiffestFrequency; }
+  Real stiffestDampingRate() const { return m_stiffestDampingRate; }
+  /// Largest stable explicit step for this cloth (infinity for implicit).
+  Real stableStep() const { return m_stableStep; }
+
+ private:
+  Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
+        const WorldSettings& world, std::vector<Real> masses);
+  void estimateStiffestMode();
+
+  std::shared_ptr<const ClothModel> m_model;
+  ClothSettings m_settings;
+  ClothForces m_forces;
+  BlockSparseMatrix m_matrix;
+  std::unique_ptr<Integrator> m_integrator;
+
+  Vec3Array m_positions, m_velocities, m_normals;
+  bool m_normalsValid = false;
+  // Frame-start copies for rollback when a frame produces non-finite state.
+  Vec3Array m_savedPositions, m_savedVelocities;
+
+  std::vector<Index> m_pinnedSorted;   // pinned vertices, increasing
+  std::vector<Index> m_pinSlotOfSorted;  // index into settings.pinnedVertices for each sorted pin
+  Vec3Array m_pinStart, m_pinEnd;      // targets at frame start and end, in settings order
+  Real m_frameStart = 0, m_frameLength = 1;
+
+  Real m_stiffestFrequency = 0, m_stiffestDampingRate = 0;
+  Real m_stableStep = 0;
+};
+
+}  // namespace weft

@@ -1,0 +1,218 @@
+#include "ClothForces.h"
+
+#include "forces/BaraffWitkin.h"
+#include "forces/SpringCondition.h"
+
+#include <cassert>
+
+namespace weft {
+
+struct ClothForces::Pass {
+  const Vec3Array& x;
+  const Vec3Array& v;
+  Vec3Array& f;
+  // Jacobian pass only:
+  Real h = 0;
+  BlockSparseMatrix* matrix = nullptr;
+  const Vec3Array* velocityForProduct = nullptr;
+  Vec3Array* stiffnessTimesVelocity = nullptr;
+};
+
+namespace {
+
+template <int N>
+Eigen::Matrix<Real, 3 * N, 1> gatherVelocities(const std::array<Index, N>& vertices,
+                                                const Vec3Array& v) {
+  Eigen::Matrix<Real, 3 * N, 1> local;
+  for (int a = 0; a < N; ++a) local.template segment<3>(3 * a) = v[vertices[a]];
+  return local;
+}
+
+}  // namespace
+
+ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& settings,
+                         std::vector<Real> masses)
+    : m_model(&model), m_settings(settings), m_masses(std::move(masses)) {
+  auto noSlots = [](auto& slots) { slots.fill(kInvalidIndex); };
+  if (settings.model == ForceModel::BaraffWitkin) {
+    m_triangles.reserve(model.triangles().size());
+    for (const TriangleRest& triangle : model.triangles()) {
+      Element<3> element{triangle.vertices, {}};
+      noSlots(element.slots);
+      m_triangles.push_back(element);
+    }
+    m_bending = settings.material.bendingStiffness != 0 || settings.material.bendingDamping != 0;
+    if (m_bending) {
+      m_hinges.reserve(model.hinges().size());
+      for (const Hinge& hinge : model.hinges()) {
+        Element<4> element{hinge.vertices, {}};
+        noSlots(element.slots);
+        m_hinges.push_back(element);
+      }
+    }
+  } else {
+    const MassSpringMaterial& springs = settings.springs;
+    m_springs.reserve(model.springs().size());
+    for (const Spring& spring : model.springs()) {
+      SpringElement element;
+      element.vertices = spring.vertices;
+      noSlots(element.slots);
+      element.restLength = spring.restLength;
+      switch (spring.kind) {
+        case SpringKind::Structural:
+          element.stiffness = springs.structuralStiffness;
+          element.damping = springs.structuralDamping;
+          break;
+        case SpringKind::Shear:
+          element.stiffness = springs.shearStiffness;
+          element.damping = springs.shearDamping;
+          break;
+        case SpringKind::Flexion:
+          element.stiffness = springs.flexionStiffness;
+          element.damping = springs.flexionDamping;
+          break;
+      }
+      // A spring family switched off costs nothing.
+      if (element.stiffness != 0 || element.damping != 0) m_springs.push_back(element);
+    }
+  }
+}
+
+std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
+  std::vector<std::array<Index, 2>> pairs;
+  auto addAll = [&pairs](const auto& vertices) {
+    for (std::size_t a = 0; a < vertices.size(); ++a)
+      for (std::size_t b = a + 1; b < vertices.size(); ++b) pairs.push_back({vertices[a], vertices[b]});
+  };
+  for (const auto& element : m_triangles) addAll(element.vertices);
+  for (const auto& element : m_hinges) addAll(element.vertices);
+  for (const auto& element : m_springs) addAll(element.vertices);
+  return pairs;
+}
+
+void ClothForces::bindMatrix(const BlockSparseMatrix& matrix) {
+  auto bind = [&matrix](auto& element) {
+    const int n = static_cast<int>(element.vertices.size());
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b) {
+        element.slots[a * n + b] = matrix.slot(element.vertices[a], element.vertices[b]);
+        assert(element.slots[a * n + b] != kInvalidIndex && "matrix built without coupledPairs()");
+      }
+  };
+  for (auto& element : m_triangles) bind(element);
+  for (auto& element : m_hinges) bind(element);
+  for (auto& element : m_springs) bind(element);
+  m_diagonalSlots.resize(m_masses.size());
+  for (Index i = 0; i < m_masses.size(); ++i) m_diagonalSlots[i] = matrix.diagonalSlot(i);
+}
+
+namespace {
+
+// Adds one element's forces, and in a Jacobian pass its blocks −h ∂f/∂v − h² ∂f/∂x and its share
+// of (∂f/∂x)·v, into the global arrays.
+template <int N, typename PassType, typename ElementType>
+void scatter(const ElementType& element, const ElementForces<N>& local, const PassType& pass) {
+  for (int a = 0; a < N; ++a) pass.f[element.vertices[a]] += local.force.template segment<3>(3 * a);
+  if (!pass.matrix) return;
+  for (int a = 0; a < N; ++a) {
+    Vec3 product = Vec3::Zero();
+    for (int b = 0; b < N; ++b) {
+      const Mat3 positionBlock = local.positionJacobian.template block<3, 3>(3 * a, 3 * b);
+      pass.matrix->block(element.slots[a * N + b]) -=
+          pass.h * local.velocityJacobian.template block<3, 3>(3 * a, 3 * b) +
+          (pass.h * pass.h) * positionBlock;
+      product += positionBlock * (*pass.velocityForProduct)[element.vertices[b]];
+    }
+    (*pass.stiffnessTimesVelocity)[element.vertices[a]] += product;
+  }
+}
+
+}  // namespace
+
+Real ClothForces::evaluate(const Pass& pass) const {
+  const ClothMaterial& material = m_settings.material;
+  const StiffnessMode mode = m_settings.stiffnessMode;
+  const bool jacobians = pass.matrix != nullptr;
+  const Vec3Array& x = pass.x;
+  const std::vector<Real>& vertexAreas = m_model->vertexAreas();
+  Real energy = 0;
+
+  // Per-vertex terms: gravity and linear air drag; the mass matrix and drag on the diagonal.
+  for (Index i = 0; i < m_masses.size(); ++i) {
+    const Real dragCoefficient = material.airDrag * vertexAreas[i];  // N·s/m
+    pass.f[i] = m_masses[i] * m_settings.gravity - dragCoefficient * (pass.v[i] - m_settings.wind);
+    energy -= m_masses[i] * m_settings.gravity.dot(x[i]);
+    if (jacobians) {
+      pass.matrix->block(m_diagonalSlots[i]) =
+          (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();
+      (*pass.stiffnessTimesVelocity)[i].setZero();
+    }
+  }
+
+  const std::vector<TriangleRest>& triangles = m_model->triangles();
+  ElementForces<3> triangleForces;
+  for (std::size_t t = 0; t < m_triangles.size(); ++t) {
+    const Element<3>& element = m_triangles[t];
+    const TriangleRest& rest = triangles[t];
+    const Vec3& x0 = x[element.vertices[0]];
+    const Vec3& x1 = x[element.vertices[1]];
+    const Vec3& x2 = x[element.vertices[2]];
+    const auto velocities = gatherVelocities<3>(element.vertices, pass.v);
+    triangleForces.setZero();
+    const StretchConditions stretch = stretchConditions(
+        x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
+    accumulateConditionForces(stretch.warp, material.warpStretchStiffness, material.stretchDamping,
+                              velocities, mode, jacobians, triangleForces);
+    accumulateConditionForces(stretch.weft, material.weftStretchStiffness, material.stretchDamping,
+                              velocities, mode, jacobians, triangleForces);
+    accumulateConditionForces(shearCondition(x0, x1, x2, rest, jacobians), material.shearStiffness,
+                              material.shearDamping, velocities, mode, jacobians, triangleForces);
+    energy += triangleForces.energy;
+    scatter<3>(element, triangleForces, pass);
+  }
+
+  const std::vector<Hinge>& hinges = m_model->hinges();
+  ElementForces<4> hingeForces;
+  for (std::size_t k = 0; k < m_hinges.size(); ++k) {
+    const Element<4>& element = m_hinges[k];
+    const auto& vertices = element.vertices;
+    hingeForces.setZero();
+    accumulateConditionForces(
+        bendCondition(x[vertices[0]], x[vertices[1]], x[vertices[2]], x[vertices[3]], hinges[k],
+                      jacobians),
+        material.bendingStiffness, material.bendingDamping,
+        gatherVelocities<4>(vertices, pass.v), mode, jacobians, hingeForces);
+    energy += hingeForces.energy;
+    scatter<4>(element, hingeForces, pass);
+  }
+
+  ElementForces<2> springForces;
+  for (const SpringElement& element : m_springs) {
+    springForces.setZero();
+    accumulateConditionForces(
+        springCondition(x[element.vertices[0]], x[element.vertices[1]], element.restLength,
+                        jacobians),
+        element.stiffness, element.damping, gatherVelocities<2>(element.vertices, pass.v), mode,
+        jacobians, springForces);
+    energy += springForces.energy;
+    scatter<2>(element, springForces, pass);
+  }
+  return energy;
+}
+
+Real ClothForces::computeForces(const Vec3Array& x, const Vec3Array& v, Vec3Array& f) const {
+  f.resize(m_masses.size());
+  return evaluate(Pass{x, v, f});
+}
+
+Real ClothForces::assemble(const Vec3Array& x, const Vec3Array& v, Real h, BlockSparseMatrix& matrix,
+                           Vec3Array& f, const Vec3Array& velocityForProduct,
+                           Vec3Array& stiffnessTimesVelocity) const {
+  f.resize(m_masses.size());
+  stiffnessTimesVelocity.resize(m_masses.size());
+  // Off-diagonal blocks accumulate; diagonal blocks are overwritten with M + h·drag first.
+  matrix.setZero();
+  return evaluate(Pass{x, v, f, h, &matrix, &velocityForProduct, &stiffnessTimesVelocity});
+}
+
+}  // namespace weft

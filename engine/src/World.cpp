@@ -1,0 +1,181 @@
+#include <weft/engine/World.h>
+
+#include "Cloth.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+namespace weft {
+
+std::string describe(StepStatus status) {
+  if (status == StepStatus::Ok) return "ok";
+  std::string text;
+  auto add = [&](StepStatus flag, const char* name) {
+    if (!hasFlag(status, flag)) return;
+    if (!text.empty()) text += '|';
+    text += name;
+  };
+  add(StepStatus::Unstable, "unstable");
+  add(StepStatus::SolverNotConverged, "solver-not-converged");
+  add(StepStatus::RolledBack, "rolled-back");
+  add(StepStatus::InvalidInput, "invalid-input");
+  return text;
+}
+
+struct World::ClothSlot {
+  std::unique_ptr<Cloth> cloth;  // null when free
+  std::uint32_t generation = 1;
+};
+
+World::World(const WorldSettings& settings) : m_settings(settings) {}
+World::~World() = default;
+World::World(World&&) noexcept = default;
+World& World::operator=(World&&) noexcept = default;
+
+const World::ClothSlot* World::find(ClothId id) const {
+  if (id.index == 0 || id.index > m_slots.size()) return nullptr;
+  const ClothSlot* slot = m_slots[id.index - 1].get();
+  return (slot->cloth && slot->generation == id.generation) ? slot : nullptr;
+}
+
+World::ClothSlot* World::find(ClothId id) {
+  return const_cast<ClothSlot*>(static_cast<const World*>(this)->find(id));
+}
+
+namespace {
+Error staleHandle(const char* operation, ClothId id) {
+  return Error{std::string(operation) + ": cloth handle {" + std::to_string(id.index) + ", " +
+               std::to_string(id.generation) +
+               "} is null or refers to a destroyed cloth; use the handle createCloth() returned"};
+}
+}  // namespace
+
+Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
+                                   const ClothSettings& settings) {
+  if (!m_settings.gravity.allFinite() || !m_settings.wind.allFinite()) {
+    return Error{"world settings: gravity or wind contains NaN or infinity"};
+  }
+  Result<std::unique_ptr<Cloth>> cloth = Cloth::create(std::move(model), settings, m_settings);
+  if (!cloth.ok()) return cloth.error();
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    if (!m_slots[k]->cloth) {
+      m_slots[k]->cloth = std::move(cloth.value());
+      return ClothId{std::uint32_t(k + 1), m_slots[k]->generation};
+    }
+  }
+  m_slots.push_back(std::make_unique<ClothSlot>());
+  m_slots.back()->cloth = std::move(cloth.value());
+  return ClothId{std::uint32_t(m_slots.size()), m_slots.back()->generation};
+}
+
+Status World::destroyCloth(ClothId id) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("destroyCloth", id);
+  slot->cloth.reset();
+  ++slot->generation;  // every copy of the old handle is now stale
+  return Status::success();
+}
+
+Status World::setPinTargets(ClothId id, std::span<const Vec3> targets) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("setPinTargets", id);
+  return slot->cloth->setPinTargets(targets);
+}
+
+Status World::setState(ClothId id, std::span<const Vec3> positions,
+                       std::span<const Vec3> velocities) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("setState", id);
+  return slot->cloth->setState(positions, velocities);
+}
+
+Result<std::vector<Vec3>> World::pinTargets(ClothId id) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("pinTargets", id);
+  return std::vector<Vec3>(slot->cloth->pinTargets().begin(), slot->cloth->pinTargets().end());
+}
+
+StepStatus World::step(Real frameDt) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!(std::isfinite(frameDt) && frameDt > 0)) {
+    m_stats.status = StepStatus::InvalidInput;
+    return m_stats.status;
+  }
+  StepStats stats;
+  stats.frame = m_stats.frame + 1;
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (!slot->cloth) continue;
+    Cloth& cloth = *slot->cloth;
+    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt);
+    stats.status |= report.status;
+    stats.substeps = std::max(stats.substeps, report.substeps);
+    stats.linearSolves += report.integrator.linearSolves;
+    stats.cgIterations += report.integrator.cgIterations;
+    stats.cgResidual = std::max(stats.cgResidual, report.integrator.cgResidual);
+    stats.potentialEnergy += report.integrator.potentialEnergy;
+    stats.kineticEnergy += cloth.kineticEnergy();
+    stats.maxStrain = std::max(stats.maxStrain, cloth.maxStrain());
+    stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
+  }
+  m_time += frameDt;
+  stats.simulatedTime = m_time;
+  stats.stepMs =
+      std::chrono::duration<Real, std::milli>(std::chrono::steady_clock::now() - start).count();
+  m_stats = stats;
+  return stats.status;
+}
+
+Result<ClothRenderView> World::renderView(ClothId id) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("renderView", id);
+  Cloth& cloth = *slot->cloth;
+  return ClothRenderView{cloth.positions(), cloth.normals(), cloth.model().indices()};
+}
+
+Result<std::span<const Vec3>> World::positions(ClothId id) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("positions", id);
+  return std::span<const Vec3>(slot->cloth->positions());
+}
+
+Result<std::span<const Vec3>> World::velocities(ClothId id) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("velocities", id);
+  return std::span<const Vec3>(slot->cloth->velocities());
+}
+
+Result<Index> World::plannedSubsteps(ClothId id, Real frameDt) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("plannedSubsteps", id);
+  if (!(std::isfinite(frameDt) && frameDt > 0)) {
+    return Error{"plannedSubsteps: frameDt must be finite and greater than 0 s"};
+  }
+  return slot->cloth->plannedSubsteps(frameDt);
+}
+
+std::uint64_t World::stateHash() const {
+  // FNV-1a over the raw bytes: any bit that differs changes the hash.
+  std::uint64_t hash = 1469598103934665603ull;
+  auto mix = [&hash](const Vec3Array& values) {
+    for (const Vec3& value : values) {
+      unsigned char bytes[sizeof(Real) * 3];
+      std::memcpy(bytes, value.data(), sizeof(bytes));
+      for (unsigned char byte : bytes) hash = (hash ^ byte) * 1099511628211ull;
+    }
+  };
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (!slot->cloth) continue;
+    mix(slot->cloth->positions());
+    mix(slot->cloth->velocities());
+  }
+  return hash;
+}
+
+Index World::clothCount() const {
+  Index count = 0;
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) count += slot->cloth ? 1 : 0;
+  return count;
+}
+
+}  // namespace weft

@@ -1,0 +1,47 @@
+// DynamicSystem: what an integrator sees of the thing it advances.
+//
+// A second-order system M ẍ = f(x, ẋ, t) over vertices, some of whose motion is prescribed
+// (pins). Explicit integrators only ask for forces; the implicit one also asks the system to
+// linearise itself into A = M − h ∂f/∂v − h² ∂f/∂x. Keeping the integrators behind this small
+// interface lets every integrator run on any scene, and lets tests drive them with tiny
+// analytic systems (a linear oscillator, a pendulum) through exactly the same code.
+#pragma once
+
+#include "solver/BlockSparseMatrix.h"
+
+#include <weft/Math.h>
+
+#include <span>
+#include <vector>
+
+namespace weft {
+
+class DynamicSystem {
+ public:
+  virtual ~DynamicSystem() = default;
+
+  /// Number of vertices (3 degrees of freedom each).
+  virtual Index vertexCount() const = 0;
+  /// kg per vertex; every mass is finite and positive.
+  virtual const std::vector<Real>& masses() const = 0;
+
+  /// Total force f(x, v, t) in N on every vertex (prescribed ones included; integrators ignore
+  /// those). Returns the potential energy in J (elastic plus gravitational).
+  virtual Real computeForces(const Vec3Array& x, const Vec3Array& v, Real t, Vec3Array& f) = 0;
+
+  /// Assembles systemMatrix() = M − h ∂f/∂v − h² ∂f/∂x at (x, v, t), and writes f(x, v, t) and
+  /// (∂f/∂x)·velocityForProduct. The Jacobians are the definite ones the solver needs.
+  /// Returns the potential energy in J, as computeForces() does.
+  virtual Real linearize(const Vec3Array& x, const Vec3Array& v, Real t, Real h, Vec3Array& f,
+                         const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) = 0;
+  /// The matrix linearize() assembles into; its pattern never changes.
+  virtual const BlockSparseMatrix& systemMatrix() const = 0;
+
+  /// Vertices whose motion is prescribed (pinned), in increasing order.
+  virtual std::span<const Index> prescribedVertices() const = 0;
+  /// Writes the prescribed position (m) and velocity (m/s) at time t into x and v for every
+  /// prescribed vertex; leaves the others untouched.
+  virtual void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const = 0;
+};
+
+}  // namespace weft

@@ -1,0 +1,50 @@
+// Integrator: advances a DynamicSystem by one step h.
+//
+// Five methods behind one interface (SolverSettings::integrator). The explicit ones only
+// evaluate forces; ImplicitEuler linearises once per step as in Baraff & Witkin 1998 (eq. 16),
+// optionally followed by Newton iterations on the full backward-Euler equations, and solves with
+// the filtered PCG. Prescribed (pinned) vertices follow DynamicSystem::applyPrescribedMotion()
+// at every stage, so every method can run every scene.
+#pragma once
+
+#include "integrators/DynamicSystem.h"
+
+#include <weft/engine/SolverSettings.h>
+
+#include <memory>
+
+namespace weft {
+
+/// What one step did, for statistics and health.
+struct IntegratorReport {
+  int linearSolves = 0;       ///< PCG solves in this step (implicit only)
+  int cgIterations = 0;       ///< PCG iterations summed over the solves
+  Real cgResidual = 0;        ///< relative residual of the last solve
+  bool cgConverged = true;    ///< false when any solve hit its iteration cap
+  Real potentialEnergy = 0;   ///< J, at the start of the step (as evaluated by the method)
+};
+
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+
+  /// An integrator of the given kind; solver settings matter to ImplicitEuler only.
+  static std::unique_ptr<Integrator> create(IntegratorKind kind, const SolverSettings& settings);
+
+  virtual IntegratorKind kind() const = 0;
+  /// Order of accuracy in h (1, 2 or 4).
+  virtual int order() const = 0;
+  /// Advances (x, v) from time t to t + h. Allocates scratch on the first call for a size only.
+  virtual void step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
+                    IntegratorReport& report) = 0;
+  /// Forgets warm-start data (after a teleport or a restore).
+  virtual void reset() {}
+};
+
+/// Largest step h (s) at which `kind` keeps a damped linear mode ẍ = −ω² x − c ẋ from growing by
+/// more than a factor (1 + growthPerStep) per step. ω in rad/s, c in 1/s. Infinity for the
+/// implicit method. Found from the method's own amplification matrix (it steps a one-vertex
+/// oscillator through the same code), so it is exact for every method without a formula each.
+Real stableStepLimit(IntegratorKind kind, Real omega, Real dampingRate, Real growthPerStep);
+
+}  // namespace weft

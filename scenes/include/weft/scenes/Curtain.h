@@ -1,0 +1,70 @@
+// The curtain benchmark of DESIGN.md §4: the reference scene every test and benchmark shares.
+//
+// A 2.0 m × 1.5 m cotton curtain in the z = 0 plane (x from −1 to +1, y from 0.5 to 2.0), its
+// top row pinned to a rod. Script over 10 s at 60 frames/s:
+//   0–1 s settle · 1–3 s a sphere pushes in and withdraws (collision issue; not yet simulated) ·
+//   4–6 s the rod pins slide toward the left end until the curtain is gathered to 30 % of its
+//   width · 6–8 s hold · 8–10 s open again.
+// The cloth starts with gentle pleats of ±5 mm out of the plane (CurtainSettings::initialWaviness)
+// so that gathering folds it out of plane, as a real curtain does, instead of crumpling it in-plane.
+// Sizes ×1, ×4, ×16, ×64 keep the physical size and refine the grid (41 × 31 up to 321 × 241).
+#pragma once
+
+#include <weft/engine/World.h>
+
+#include <memory>
+
+namespace weft {
+
+/// Settings of a curtain run.
+struct CurtainSettings {
+  Index size = 1;  ///< refinement: 1, 4, 16 or 64 times the triangles of the 41 × 31 curtain
+  ForceModel forceModel = ForceModel::BaraffWitkin;  ///< internal forces
+  ClothMaterial material;    ///< defaults: the cotton-like curtain material
+  SolverSettings solver;     ///< integrator and solver
+  bool pinScript = true;     ///< run the rod script (gather and re-open); false keeps the rod still
+  /// m, amplitude of gentle pleats the curtain starts with (z = a·sin(2πx / 0.25 m), fading to 0
+  /// at the rod). A real curtain never hangs perfectly flat, and a perfectly planar one has no
+  /// way to choose a side when the rod gathers it: it can only crumple in its own plane.
+  Real initialWaviness = 0.005;
+};
+
+/// The curtain scene: a World with one cloth and the pin script.
+class CurtainScene {
+ public:
+  static constexpr Real kFrameDt = 1.0 / 60.0;  ///< s, one frame
+  static constexpr Index kFrames = 600;          ///< frames of the full 10 s script
+  static constexpr Real kGatheredFraction = 0.3; ///< width of the gathered curtain / full width
+
+  /// Builds the scene; fails on a size other than 1, 4, 16, 64 or on invalid settings.
+  static Result<CurtainScene> create(const CurtainSettings& settings = {});
+
+  /// Moves the rod to where the script puts it at the end of the next frame, then steps.
+  StepStatus stepFrame();
+
+  World& world() { return *m_world; }
+  const World& world() const { return *m_world; }
+  ClothId cloth() const { return m_cloth; }
+  const ClothModel& model() const { return *m_model; }
+  std::shared_ptr<const ClothModel> sharedModel() const { return m_model; }
+  /// Frames stepped so far.
+  Index frame() const { return m_frame; }
+
+  /// Grid vertices along the width and height for a size (41 × 31 for size 1).
+  static std::array<Index, 2> gridSize(Index size);
+  /// Where the script puts a rod pin that starts at restPosition, at time t (s).
+  static Vec3 pinTarget(const Vec3& restPosition, Real t);
+
+ private:
+  CurtainScene() = default;
+
+  std::unique_ptr<World> m_world;
+  std::shared_ptr<const ClothModel> m_model;
+  ClothId m_cloth;
+  Vec3Array m_pinRest;          // rest positions of the pinned vertices
+  Vec3Array m_targets;          // scratch: this frame's targets
+  bool m_pinScript = true;
+  Index m_frame = 0;
+};
+
+}  // namespace weft

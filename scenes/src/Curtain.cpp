@@ -1,0 +1,95 @@
+#include <weft/scenes/Curtain.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace weft {
+namespace {
+
+// C¹ ease in and out over [0, 1], so the rod starts and stops without a jerk.
+Real smoothstep(Real s) {
+  s = std::clamp<Real>(s, 0, 1);
+  return s * s * (3 - 2 * s);
+}
+
+}  // namespace
+
+std::array<Index, 2> CurtainScene::gridSize(Index size) {
+  const Index refinement = size == 64 ? 8 : size == 16 ? 4 : size == 4 ? 2 : 1;
+  return {40 * refinement + 1, 30 * refinement + 1};
+}
+
+Vec3 CurtainScene::pinTarget(const Vec3& restPosition, Real t) {
+  // Gather between 4 and 6 s, hold until 8 s, open again by 10 s. The left end (x = −1) stays.
+  Real gathered = 0;
+  if (t > 4 && t <= 6) gathered = smoothstep((t - 4) / 2);
+  else if (t > 6 && t <= 8) gathered = 1;
+  else if (t > 8) gathered = 1 - smoothstep((t - 8) / 2);
+  const Real scale = 1 - (1 - kGatheredFraction) * gathered;
+  return Vec3(-1 + (restPosition.x() + 1) * scale, restPosition.y(), restPosition.z());
+}
+
+Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
+  if (settings.size != 1 && settings.size != 4 && settings.size != 16 && settings.size != 64) {
+    return Error{"curtain size " + std::to_string(settings.size) +
+                 " is not offered: choose 1, 4, 16 or 64"};
+  }
+  GridSettings grid;  // the defaults are the curtain's geometry
+  const std::array<Index, 2> dimensions = gridSize(settings.size);
+  grid.columns = dimensions[0];
+  grid.rows = dimensions[1];
+  Result<ClothModel> model = ClothModel::grid(grid);
+  if (!model.ok()) return model.error();
+
+  CurtainScene scene;
+  scene.m_model = std::make_shared<const ClothModel>(std::move(model).value());
+  scene.m_world = std::make_unique<World>();
+  scene.m_pinScript = settings.pinScript;
+
+  ClothSettings cloth;
+  cloth.forceModel = settings.forceModel;
+  cloth.material = settings.material;
+  cloth.solver = settings.solver;
+  const Index topRow = grid.rows - 1;
+  for (Index column = 0; column < grid.columns; ++column) {
+    cloth.pinnedVertices.push_back(topRow * grid.columns + column);
+  }
+  for (Index vertex : cloth.pinnedVertices) {
+    scene.m_pinRest.push_back(scene.m_model->restPositions()[vertex]);
+  }
+  scene.m_targets = scene.m_pinRest;
+  Result<ClothId> id = scene.m_world->createCloth(scene.m_model, cloth);
+  if (!id.ok()) return id.error();
+  scene.m_cloth = id.value();
+
+  if (settings.initialWaviness != 0) {
+    if (!std::isfinite(settings.initialWaviness)) {
+      return Error{"curtain initialWaviness must be finite (metres)"};
+    }
+    constexpr Real kPleatWavelength = 0.25;  // m: eight pleats across the 2 m curtain
+    constexpr Real kPi = 3.14159265358979323846;
+    const Vec3Array& rest = scene.m_model->restPositions();
+    Vec3Array positions = rest;
+    for (Vec3& p : positions) {
+      const Real fade = (grid.origin.y() + grid.height - p.y()) / grid.height;  // 0 at the rod
+      p.z() += settings.initialWaviness * fade * std::sin(2 * kPi * (p.x() + 1) / kPleatWavelength);
+    }
+    const Vec3Array velocities(positions.size(), Vec3::Zero());
+    Status state = scene.m_world->setState(scene.m_cloth, positions, velocities);
+    if (!state.ok()) return state.error();
+  }
+  return scene;
+}
+
+StepStatus CurtainScene::stepFrame() {
+  if (m_pinScript) {
+    const Real endTime = (m_frame + 1) * kFrameDt;
+    for (std::size_t k = 0; k < m_pinRest.size(); ++k) m_targets[k] = pinTarget(m_pinRest[k], endTime);
+    // Cannot fail: one finite target per pin, on a live handle.
+    (void)m_world->setPinTargets(m_cloth, m_targets);
+  }
+  ++m_frame;
+  return m_world->step(kFrameDt);
+}
+
+}  // namespace weft
