@@ -28,6 +28,7 @@ struct CurtainRunOptions {
   std::string frameCsv;            ///< per-frame CSV path; empty = none
   IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< time integrator
   bool progress = true;            ///< print a progress line every second of simulated time
+  bool overlap = true;             ///< render frame k while simulating frame k+1 (off: in turn)
 };
 
 /// Runs the curtain and prints the report to `out`. Returns a process exit code: 0 when the run

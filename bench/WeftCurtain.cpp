@@ -6,6 +6,7 @@
 
 #include <iostream>
 #include <map>
+#include <sstream>
 
 int main(int argc, char** argv) {
   weft::CurtainRunOptions options;
@@ -36,12 +37,16 @@ int main(int argc, char** argv) {
       {"rk4", weft::IntegratorKind::RungeKutta4}};
   app.add_option("--integrator", options.integrator, "Time integrator")
       ->transform(CLI::CheckedTransformer(integrators, CLI::ignore_case));
+  std::string overlap = "on";
+  app.add_option("--overlap", overlap, "Render frame k while simulating frame k+1: on or off")
+      ->check(CLI::IsMember({"on", "off"}));
   bool quiet = false;
   app.add_flag("--quiet", quiet, "No progress lines");
   CLI11_PARSE(app, argc, argv);
 
   options.selfCollision = selfCollision == "on";
   options.progress = !quiet;
+  options.overlap = overlap == "on";
   if (render == "off") {
     options.renderWidth = options.renderHeight = 0;
   } else {
