@@ -133,6 +133,9 @@ Real ClothForces::evaluate(const Pass& pass) const {
   const ClothMaterial& material = m_settings.material;
   const StiffnessMode mode = m_settings.stiffnessMode;
   const bool jacobians = pass.matrix != nullptr;
+  // The Definite mode keeps C ∇²C only for stretched convex conditions (stretch), so the shear
+  // and bending Hessians, by far the costliest part of a kernel, are computed only in Exact mode.
+  const bool curvatureOfNonConvex = jacobians && mode == StiffnessMode::Exact;
   const Vec3Array& x = pass.x;
   const std::vector<Real>& vertexAreas = m_model->vertexAreas();
   Real energy = 0;
@@ -165,7 +168,8 @@ Real ClothForces::evaluate(const Pass& pass) const {
                               velocities, mode, jacobians, triangleForces);
     accumulateConditionForces(stretch.weft, material.weftStretchStiffness, material.stretchDamping,
                               velocities, mode, jacobians, triangleForces);
-    accumulateConditionForces(shearCondition(x0, x1, x2, rest, jacobians), material.shearStiffness,
+    accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
+                              material.shearStiffness,
                               material.shearDamping, velocities, mode, jacobians, triangleForces);
     energy += triangleForces.energy;
     scatter<3>(element, triangleForces, pass);
@@ -179,7 +183,7 @@ Real ClothForces::evaluate(const Pass& pass) const {
     hingeForces.setZero();
     accumulateConditionForces(
         bendCondition(x[vertices[0]], x[vertices[1]], x[vertices[2]], x[vertices[3]], hinges[k],
-                      jacobians),
+                      curvatureOfNonConvex),
         material.bendingStiffness, material.bendingDamping,
         gatherVelocities<4>(vertices, pass.v), mode, jacobians, hingeForces);
     energy += hingeForces.energy;
