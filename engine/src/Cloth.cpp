@@ -87,20 +87,22 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
 
 Result<std::unique_ptr<Cloth>> Cloth::create(std::shared_ptr<const ClothModel> model,
                                              const ClothSettings& settings,
-                                             const WorldSettings& world) {
+                                             const WorldSettings& world, TaskSystem* tasks) {
   if (std::string problem = validate(model.get(), settings); !problem.empty()) return Error{problem};
   std::vector<Real> masses = model->vertexMasses(settings.material.arealDensity);
-  return std::unique_ptr<Cloth>(new Cloth(std::move(model), settings, world, std::move(masses)));
+  return std::unique_ptr<Cloth>(
+      new Cloth(std::move(model), settings, world, std::move(masses), tasks));
 }
 
 Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
-             const WorldSettings& world, std::vector<Real> masses)
+             const WorldSettings& world, std::vector<Real> masses, TaskSystem* tasks)
     : m_model(std::move(model)),
+      m_tasks(tasks),
       m_settings(settings),
       m_forces(*m_model,
                ClothForceSettings{settings.forceModel, settings.material, settings.springs,
                                   world.gravity, world.wind, StiffnessMode::Definite},
-               std::move(masses)) {
+               std::move(masses), tasks) {
   const std::vector<std::array<Index, 2>> pairs = m_forces.coupledPairs();
   m_matrix.build(m_model->vertexCount(), pairs);
   m_forces.bindMatrix(m_matrix);

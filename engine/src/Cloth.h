@@ -27,7 +27,7 @@ class Cloth final : public DynamicSystem {
   /// Validates settings; the error names the field and the fix.
   static Result<std::unique_ptr<Cloth>> create(std::shared_ptr<const ClothModel> model,
                                                const ClothSettings& settings,
-                                               const WorldSettings& world);
+                                               const WorldSettings& world, TaskSystem* tasks);
 
   // DynamicSystem
   Index vertexCount() const override { return m_model->vertexCount(); }
@@ -38,6 +38,7 @@ class Cloth final : public DynamicSystem {
   const BlockSparseMatrix& systemMatrix() const override { return m_matrix; }
   std::span<const Index> prescribedVertices() const override { return m_pinnedSorted; }
   void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const override;
+  TaskSystem* taskSystem() override { return m_tasks; }
 
   /// Advances by one frame of length frameDt starting at world time t.
   ClothFrameReport stepFrame(Real t, Real frameDt);
@@ -70,10 +71,11 @@ class Cloth final : public DynamicSystem {
 
  private:
   Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
-        const WorldSettings& world, std::vector<Real> masses);
+        const WorldSettings& world, std::vector<Real> masses, TaskSystem* tasks);
   void estimateStiffestMode();
 
   std::shared_ptr<const ClothModel> m_model;
+  TaskSystem* m_tasks;
   ClothSettings m_settings;
   ClothForces m_forces;
   BlockSparseMatrix m_matrix;

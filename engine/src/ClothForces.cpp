@@ -3,7 +3,11 @@
 #include "forces/BaraffWitkin.h"
 #include "forces/SpringCondition.h"
 
+#include <weft/threading/GrainSizes.h>
+
+#include <algorithm>
 #include <cassert>
+#include <cstdint>
 
 namespace weft {
 
@@ -28,16 +32,52 @@ Eigen::Matrix<Real, 3 * N, 1> gatherVelocities(const std::array<Index, N>& verti
   return local;
 }
 
+// Greedy colouring in element order: each element takes the lowest colour none of its vertices
+// has used yet; then the elements are stably sorted by colour. Deterministic, and near the
+// minimum on meshes (a regular grid's triangles need 6, its hinges about 10). Colours are tracked
+// in a 64-bit mask per vertex; elements that find all 63 regular colours taken (vertices of
+// absurd valence) go to a last, overflow colour that runs as one serial block.
+constexpr Index kOverflowColour = 63;
+
+template <typename ElementType>
+std::vector<Index> colourElements(std::vector<ElementType>& elements, Index vertexCount) {
+  std::vector<std::uint64_t> usedColours(vertexCount, 0);  // bit k: the vertex has colour k
+  std::vector<Index> colourOf(elements.size());
+  Index colourCount = 0;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    std::uint64_t taken = 0;
+    for (Index vertex : elements[e].vertices) taken |= usedColours[vertex];
+    Index colour = 0;
+    while (colour < kOverflowColour && (taken >> colour & 1u)) ++colour;
+    colourOf[e] = colour;
+    for (Index vertex : elements[e].vertices) usedColours[vertex] |= std::uint64_t(1) << colour;
+    colourCount = std::max(colourCount, colour + 1);
+  }
+  std::vector<Index> order(elements.size());
+  for (std::size_t e = 0; e < order.size(); ++e) order[e] = Index(e);
+  std::stable_sort(order.begin(), order.end(),
+                   [&](Index a, Index b) { return colourOf[a] < colourOf[b]; });
+  std::vector<ElementType> sorted;
+  sorted.reserve(elements.size());
+  for (Index e : order) sorted.push_back(elements[e]);
+  elements = std::move(sorted);
+  std::vector<Index> offsets(colourCount + 1, 0);
+  for (Index e : order) ++offsets[colourOf[e] + 1];
+  for (Index k = 0; k < colourCount; ++k) offsets[k + 1] += offsets[k];
+  return offsets;
+}
+
 }  // namespace
 
 ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& settings,
-                         std::vector<Real> masses)
-    : m_model(&model), m_settings(settings), m_masses(std::move(masses)) {
+                         std::vector<Real> masses, TaskSystem* tasks)
+    : m_model(&model), m_settings(settings), m_masses(std::move(masses)), m_tasks(tasks),
+      m_serialTasks(std::make_unique<TaskSystem>(TaskSystemSettings{1})) {
   auto noSlots = [](auto& slots) { slots.fill(kInvalidIndex); };
   if (settings.model == ForceModel::BaraffWitkin) {
     m_triangles.reserve(model.triangles().size());
     for (const TriangleRest& triangle : model.triangles()) {
-      Element<3> element{triangle.vertices, {}};
+      Element<3> element{triangle.vertices, {}, Index(m_triangles.size())};
       noSlots(element.slots);
       m_triangles.push_back(element);
     }
@@ -45,7 +85,7 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
     if (m_bending) {
       m_hinges.reserve(model.hinges().size());
       for (const Hinge& hinge : model.hinges()) {
-        Element<4> element{hinge.vertices, {}};
+        Element<4> element{hinge.vertices, {}, Index(m_hinges.size())};
         noSlots(element.slots);
         m_hinges.push_back(element);
       }
@@ -56,6 +96,7 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
     for (const Spring& spring : model.springs()) {
       SpringElement element;
       element.vertices = spring.vertices;
+      element.modelIndex = Index(&spring - model.springs().data());
       noSlots(element.slots);
       element.restLength = spring.restLength;
       switch (spring.kind) {
@@ -76,6 +117,9 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
       if (element.stiffness != 0 || element.damping != 0) m_springs.push_back(element);
     }
   }
+  m_triangleColours = colourElements(m_triangles, model.vertexCount());
+  m_hingeColours = colourElements(m_hinges, model.vertexCount());
+  m_springColours = colourElements(m_springs, model.vertexCount());
 }
 
 std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
@@ -138,69 +182,107 @@ Real ClothForces::evaluate(const Pass& pass) const {
   const bool curvatureOfNonConvex = jacobians && mode == StiffnessMode::Exact;
   const Vec3Array& x = pass.x;
   const std::vector<Real>& vertexAreas = m_model->vertexAreas();
-  Real energy = 0;
+  TaskSystem& tasks = m_tasks ? *m_tasks : *m_serialTasks;
+  const auto sum = [](Real a, Real b) { return a + b; };
 
   // Per-vertex terms: gravity and linear air drag; the mass matrix and drag on the diagonal.
-  for (Index i = 0; i < m_masses.size(); ++i) {
-    const Real dragCoefficient = material.airDrag * vertexAreas[i];  // N·s/m
-    pass.f[i] = m_masses[i] * m_settings.gravity - dragCoefficient * (pass.v[i] - m_settings.wind);
-    energy -= m_masses[i] * m_settings.gravity.dot(x[i]);
-    if (jacobians) {
-      pass.matrix->block(m_diagonalSlots[i]) =
-          (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();
-      (*pass.stiffnessTimesVelocity)[i].setZero();
+  Real energy = tasks.parallelReduce(
+      Index(m_masses.size()), kGrainVertices, Real(0),
+      [&](Index begin, Index end) {
+        Real blockEnergy = 0;
+        for (Index i = begin; i < end; ++i) {
+          const Real dragCoefficient = material.airDrag * vertexAreas[i];  // N·s/m
+          pass.f[i] =
+              m_masses[i] * m_settings.gravity - dragCoefficient * (pass.v[i] - m_settings.wind);
+          blockEnergy -= m_masses[i] * m_settings.gravity.dot(x[i]);
+          if (jacobians) {
+            pass.matrix->block(m_diagonalSlots[i]) =
+                (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();
+            (*pass.stiffnessTimesVelocity)[i].setZero();
+          }
+        }
+        return blockEnergy;
+      },
+      sum);
+
+  // One colour at a time: within a colour no two elements share a vertex, so their scatters
+  // never touch the same entry.
+  const auto forEachColour = [&](const std::vector<Index>& colours, auto&& elementRange) {
+    for (std::size_t colour = 0; colour + 1 < colours.size(); ++colour) {
+      const Index first = colours[colour];
+      const Index count = colours[colour + 1] - first;
+      // The overflow colour may hold elements that share vertices: one block, one thread.
+      const Index grain = colour == kOverflowColour ? std::max<Index>(count, 1) : kGrainElements;
+      energy += tasks.parallelReduce(
+          count, grain, Real(0),
+          [&](Index begin, Index end) { return elementRange(first + begin, first + end); }, sum);
     }
-  }
+  };
 
   const std::vector<TriangleRest>& triangles = m_model->triangles();
-  ElementForces<3> triangleForces;
-  for (std::size_t t = 0; t < m_triangles.size(); ++t) {
-    const Element<3>& element = m_triangles[t];
-    const TriangleRest& rest = triangles[t];
-    const Vec3& x0 = x[element.vertices[0]];
-    const Vec3& x1 = x[element.vertices[1]];
-    const Vec3& x2 = x[element.vertices[2]];
-    const auto velocities = gatherVelocities<3>(element.vertices, pass.v);
-    triangleForces.setZero();
-    const StretchConditions stretch = stretchConditions(
-        x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
-    accumulateConditionForces(stretch.warp, material.warpStretchStiffness, material.stretchDamping,
-                              velocities, mode, jacobians, triangleForces);
-    accumulateConditionForces(stretch.weft, material.weftStretchStiffness, material.stretchDamping,
-                              velocities, mode, jacobians, triangleForces);
-    accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
-                              material.shearStiffness,
-                              material.shearDamping, velocities, mode, jacobians, triangleForces);
-    energy += triangleForces.energy;
-    scatter<3>(element, triangleForces, pass);
-  }
+  forEachColour(m_triangleColours, [&](Index begin, Index end) {
+    Real blockEnergy = 0;
+    ElementForces<3> triangleForces;
+    for (Index t = begin; t < end; ++t) {
+      const Element<3>& element = m_triangles[t];
+      const TriangleRest& rest = triangles[element.modelIndex];
+      const Vec3& x0 = x[element.vertices[0]];
+      const Vec3& x1 = x[element.vertices[1]];
+      const Vec3& x2 = x[element.vertices[2]];
+      const auto velocities = gatherVelocities<3>(element.vertices, pass.v);
+      triangleForces.setZero();
+      const StretchConditions stretch = stretchConditions(
+          x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
+      accumulateConditionForces(stretch.warp, material.warpStretchStiffness,
+                                material.stretchDamping, velocities, mode, jacobians,
+                                triangleForces);
+      accumulateConditionForces(stretch.weft, material.weftStretchStiffness,
+                                material.stretchDamping, velocities, mode, jacobians,
+                                triangleForces);
+      accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
+                                material.shearStiffness, material.shearDamping, velocities, mode,
+                                jacobians, triangleForces);
+      blockEnergy += triangleForces.energy;
+      scatter<3>(element, triangleForces, pass);
+    }
+    return blockEnergy;
+  });
 
   const std::vector<Hinge>& hinges = m_model->hinges();
-  ElementForces<4> hingeForces;
-  for (std::size_t k = 0; k < m_hinges.size(); ++k) {
-    const Element<4>& element = m_hinges[k];
-    const auto& vertices = element.vertices;
-    hingeForces.setZero();
-    accumulateConditionForces(
-        bendCondition(x[vertices[0]], x[vertices[1]], x[vertices[2]], x[vertices[3]], hinges[k],
-                      curvatureOfNonConvex),
-        material.bendingStiffness, material.bendingDamping,
-        gatherVelocities<4>(vertices, pass.v), mode, jacobians, hingeForces);
-    energy += hingeForces.energy;
-    scatter<4>(element, hingeForces, pass);
-  }
+  forEachColour(m_hingeColours, [&](Index begin, Index end) {
+    Real blockEnergy = 0;
+    ElementForces<4> hingeForces;
+    for (Index k = begin; k < end; ++k) {
+      const Element<4>& element = m_hinges[k];
+      const auto& vertices = element.vertices;
+      hingeForces.setZero();
+      accumulateConditionForces(
+          bendCondition(x[vertices[0]], x[vertices[1]], x[vertices[2]], x[vertices[3]],
+                        hinges[element.modelIndex], curvatureOfNonConvex),
+          material.bendingStiffness, material.bendingDamping,
+          gatherVelocities<4>(vertices, pass.v), mode, jacobians, hingeForces);
+      blockEnergy += hingeForces.energy;
+      scatter<4>(element, hingeForces, pass);
+    }
+    return blockEnergy;
+  });
 
-  ElementForces<2> springForces;
-  for (const SpringElement& element : m_springs) {
-    springForces.setZero();
-    accumulateConditionForces(
-        springCondition(x[element.vertices[0]], x[element.vertices[1]], element.restLength,
-                        jacobians),
-        element.stiffness, element.damping, gatherVelocities<2>(element.vertices, pass.v), mode,
-        jacobians, springForces);
-    energy += springForces.energy;
-    scatter<2>(element, springForces, pass);
-  }
+  forEachColour(m_springColours, [&](Index begin, Index end) {
+    Real blockEnergy = 0;
+    ElementForces<2> springForces;
+    for (Index k = begin; k < end; ++k) {
+      const SpringElement& element = m_springs[k];
+      springForces.setZero();
+      accumulateConditionForces(
+          springCondition(x[element.vertices[0]], x[element.vertices[1]], element.restLength,
+                          jacobians),
+          element.stiffness, element.damping, gatherVelocities<2>(element.vertices, pass.v), mode,
+          jacobians, springForces);
+      blockEnergy += springForces.energy;
+      scatter<2>(element, springForces, pass);
+    }
+    return blockEnergy;
+  });
   return energy;
 }
 

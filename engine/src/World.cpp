@@ -2,6 +2,8 @@
 
 #include "Cloth.h"
 
+#include <weft/threading/Profiler.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -28,7 +30,16 @@ struct World::ClothSlot {
   std::uint32_t generation = 1;
 };
 
-World::World(const WorldSettings& settings) : m_settings(settings) {}
+World::World(const WorldSettings& settings) : m_settings(settings) {
+  if (settings.taskSystem) {
+    m_tasks = settings.taskSystem;
+  } else {
+    m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{std::max(0, settings.threadCount)});
+    m_tasks = m_ownedTasks.get();
+  }
+}
+
+int World::threadCount() const { return m_tasks->threadCount(); }
 World::~World() = default;
 World::World(World&&) noexcept = default;
 World& World::operator=(World&&) noexcept = default;
@@ -56,7 +67,8 @@ Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
   if (!m_settings.gravity.allFinite() || !m_settings.wind.allFinite()) {
     return Error{"world settings: gravity or wind contains NaN or infinity"};
   }
-  Result<std::unique_ptr<Cloth>> cloth = Cloth::create(std::move(model), settings, m_settings);
+  Result<std::unique_ptr<Cloth>> cloth =
+      Cloth::create(std::move(model), settings, m_settings, m_tasks);
   if (!cloth.ok()) return cloth.error();
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     if (!m_slots[k]->cloth) {
@@ -98,6 +110,8 @@ Result<std::vector<Vec3>> World::pinTargets(ClothId id) const {
 
 StepStatus World::step(Real frameDt) {
   const auto start = std::chrono::steady_clock::now();
+  Profiler::instance().beginFrame(m_stats.frame + 1);
+  WEFT_PROFILE_ZONE("step");
   if (!(std::isfinite(frameDt) && frameDt > 0)) {
     m_stats.status = StepStatus::InvalidInput;
     return m_stats.status;
@@ -114,6 +128,8 @@ StepStatus World::step(Real frameDt) {
     stats.cgIterations += report.integrator.cgIterations;
     stats.cgResidual = std::max(stats.cgResidual, report.integrator.cgResidual);
     stats.potentialEnergy += report.integrator.potentialEnergy;
+    stats.assemblyMs += report.integrator.assemblyMs;
+    stats.solveMs += report.integrator.solveMs;
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxStrain = std::max(stats.maxStrain, cloth.maxStrain());
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());

@@ -43,7 +43,10 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
 
   CurtainScene scene;
   scene.m_model = std::make_shared<const ClothModel>(std::move(model).value());
-  scene.m_world = std::make_unique<World>();
+  WorldSettings worldSettings;
+  worldSettings.threadCount = settings.threadCount;
+  worldSettings.taskSystem = settings.taskSystem;
+  scene.m_world = std::make_unique<World>(worldSettings);
   scene.m_pinScript = settings.pinScript;
 
   ClothSettings cloth;

@@ -10,6 +10,7 @@
 #include "solver/BlockSparseMatrix.h"
 
 #include <weft/Math.h>
+#include <weft/threading/TaskSystem.h>
 
 #include <span>
 #include <vector>
@@ -42,6 +43,9 @@ class DynamicSystem {
   /// Writes the prescribed position (m) and velocity (m/s) at time t into x and v for every
   /// prescribed vertex; leaves the others untouched.
   virtual void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const = 0;
+
+  /// Where the integrator may run its own parallel loops (the linear solve); null: serial.
+  virtual TaskSystem* taskSystem() { return nullptr; }
 };
 
 }  // namespace weft

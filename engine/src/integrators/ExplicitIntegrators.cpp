@@ -5,14 +5,21 @@
 // Scratch arrays are sized on the first step and reused: no allocation in steady state.
 #include "integrators/ExplicitIntegrators.h"
 
+#include <weft/threading/FrameClock.h>
+#include <weft/threading/Profiler.h>
+
 namespace weft {
 namespace {
 
 // a = f / m for free vertices; prescribed vertices get zero (their motion is scripted).
 void accelerations(DynamicSystem& system, const Vec3Array& x, const Vec3Array& v, Real t,
-                   Vec3Array& force, Vec3Array& acceleration, Real* potentialEnergy = nullptr) {
+                   Vec3Array& force, Vec3Array& acceleration, IntegratorReport& report,
+                   bool firstStage) {
+  WEFT_PROFILE_ZONE("assembly");
+  const std::int64_t start = FrameClock::nowNs();
   const Real energy = system.computeForces(x, v, t, force);
-  if (potentialEnergy) *potentialEnergy = energy;
+  report.assemblyMs += FrameClock::msSince(start);
+  if (firstStage) report.potentialEnergy = energy;
   const std::vector<Real>& masses = system.masses();
   for (std::size_t i = 0; i < x.size(); ++i) acceleration[i] = force[i] / masses[i];
   for (Index pinned : system.prescribedVertices()) acceleration[pinned].setZero();
@@ -28,7 +35,7 @@ void ExplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
                          IntegratorReport& report) {
   const Index n = system.vertexCount();
   resizeAll(n, {&m_force, &m_acceleration});
-  accelerations(system, x, v, t, m_force, m_acceleration, &report.potentialEnergy);
+  accelerations(system, x, v, t, m_force, m_acceleration, report, true);
   for (Index i = 0; i < n; ++i) {
     x[i] += h * v[i];  // with the old velocity: this is what makes the method explicit
     v[i] += h * m_acceleration[i];
@@ -40,7 +47,7 @@ void SymplecticEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Re
                            IntegratorReport& report) {
   const Index n = system.vertexCount();
   resizeAll(n, {&m_force, &m_acceleration});
-  accelerations(system, x, v, t, m_force, m_acceleration, &report.potentialEnergy);
+  accelerations(system, x, v, t, m_force, m_acceleration, report, true);
   for (Index i = 0; i < n; ++i) {
     v[i] += h * m_acceleration[i];
     x[i] += h * v[i];  // with the new velocity: symplectic for conservative forces
@@ -52,13 +59,14 @@ void Midpoint::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, R
                     IntegratorReport& report) {
   const Index n = system.vertexCount();
   resizeAll(n, {&m_force, &m_acceleration, &m_midPosition, &m_midVelocity});
-  accelerations(system, x, v, t, m_force, m_acceleration, &report.potentialEnergy);
+  accelerations(system, x, v, t, m_force, m_acceleration, report, true);
   for (Index i = 0; i < n; ++i) {
     m_midPosition[i] = x[i] + 0.5 * h * v[i];
     m_midVelocity[i] = v[i] + 0.5 * h * m_acceleration[i];
   }
   system.applyPrescribedMotion(t + 0.5 * h, m_midPosition, m_midVelocity);
-  accelerations(system, m_midPosition, m_midVelocity, t + 0.5 * h, m_force, m_acceleration);
+  accelerations(system, m_midPosition, m_midVelocity, t + 0.5 * h, m_force, m_acceleration,
+                report, false);
   for (Index i = 0; i < n; ++i) {
     x[i] += h * m_midVelocity[i];
     v[i] += h * m_acceleration[i];
@@ -85,7 +93,7 @@ void RungeKutta4::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t
     const Real stageTime = t + stageOffset[stage] * h;
     system.applyPrescribedMotion(stageTime, m_stagePosition, m_stageVelocity);
     accelerations(system, m_stagePosition, m_stageVelocity, stageTime, m_force, m_acceleration,
-                  stage == 0 ? &report.potentialEnergy : nullptr);
+                  report, stage == 0);
     const Real nextOffset = stage < 3 ? stageOffset[stage + 1] * h : 0.0;
     for (Index i = 0; i < n; ++i) {
       const Vec3 positionRate = m_stageVelocity[i];

@@ -1,5 +1,8 @@
 #include "integrators/ImplicitEuler.h"
 
+#include <weft/threading/FrameClock.h>
+#include <weft/threading/Profiler.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -25,8 +28,11 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   pcgSettings.tolerance = m_settings.cgTolerance;
   pcgSettings.maxIterations = m_settings.cgMaxIterations;
   pcgSettings.warmStart = true;  // the caller prepares the initial guess in m_correction
-  const SolveReport solve =
-      m_pcg.solve(system.systemMatrix(), m_rightHandSide, m_filter, pcgSettings, m_correction);
+  WEFT_PROFILE_ZONE("solve");
+  const std::int64_t start = FrameClock::nowNs();
+  const SolveReport solve = m_pcg.solve(system.systemMatrix(), m_rightHandSide, m_filter,
+                                        pcgSettings, m_correction, system.taskSystem());
+  report.solveMs += FrameClock::msSince(start);
   ++report.linearSolves;
   report.cgIterations += solve.iterations;
   report.cgResidual = solve.relativeResidual;
@@ -49,7 +55,12 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   }
 
   // Baraff–Witkin step, expanded about (x_n, v_n).
-  report.potentialEnergy = system.linearize(x, v, t, h, m_force, v, m_stiffnessTimesVelocity);
+  {
+    WEFT_PROFILE_ZONE("assembly");
+    const std::int64_t start = FrameClock::nowNs();
+    report.potentialEnergy = system.linearize(x, v, t, h, m_force, v, m_stiffnessTimesVelocity);
+    report.assemblyMs += FrameClock::msSince(start);
+  }
   for (Index i = 0; i < n; ++i) {
     m_rightHandSide[i] = h * (m_force[i] + h * m_stiffnessTimesVelocity[i]);
   }
@@ -69,8 +80,13 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
       m_iterateVelocity[i] = v[i] + m_deltaV[i];
       m_iteratePosition[i] = x[i] + h * m_iterateVelocity[i];
     }
-    system.linearize(m_iteratePosition, m_iterateVelocity, t + h, h, m_force, m_iterateVelocity,
-                     m_stiffnessTimesVelocity);
+    {
+      WEFT_PROFILE_ZONE("assembly");
+      const std::int64_t start = FrameClock::nowNs();
+      system.linearize(m_iteratePosition, m_iterateVelocity, t + h, h, m_force, m_iterateVelocity,
+                       m_stiffnessTimesVelocity);
+      report.assemblyMs += FrameClock::msSince(start);
+    }
     for (Index i = 0; i < n; ++i) {
       m_rightHandSide[i] = h * m_force[i] - masses[i] * m_deltaV[i];
       m_correction[i].setZero();

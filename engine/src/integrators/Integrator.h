@@ -22,6 +22,8 @@ struct IntegratorReport {
   Real cgResidual = 0;        ///< relative residual of the last solve
   bool cgConverged = true;    ///< false when any solve hit its iteration cap
   Real potentialEnergy = 0;   ///< J, at the start of the step (as evaluated by the method)
+  Real assemblyMs = 0;        ///< ms spent evaluating forces and assembling the system
+  Real solveMs = 0;           ///< ms spent in PCG solves
 };
 
 class Integrator {

@@ -151,7 +151,13 @@ void FilteredPcg::resize(Index vertexCount) {
 template <typename Kernel>
 Real FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
   const Index blockCount = (vertexCount + kReductionBlock - 1) / kReductionBlock;
-  // A parallel version runs this loop's bodies on any threads; the combine below stays serial.
+  if (m_tasks) {
+    // Fixed blocks, partials combined in block order: the same bits as the loop below.
+    return m_tasks->parallelReduce(
+        vertexCount, kReductionBlock, Real(0),
+        [&](Index begin, Index end) { return kernel(begin, end); },
+        [](Real sum, Real partial) { return sum + partial; });
+  }
   for (Index block = 0; block < blockCount; ++block) {
     const Index begin = block * kReductionBlock;
     m_blockPartials[block] = kernel(begin, std::min(begin + kReductionBlock, vertexCount));
@@ -164,6 +170,11 @@ Real FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
 
 template <typename Kernel>
 void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
+  if (m_tasks) {
+    m_tasks->parallelFor(vertexCount, kReductionBlock,
+                         [&](Index begin, Index end, int) { kernel(begin, end); });
+    return;
+  }
   for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
     kernel(begin, std::min(begin + kReductionBlock, vertexCount));
   }
@@ -171,8 +182,9 @@ void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
 
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
                                const VertexFilter& filter, const PcgSettings& settings,
-                               Vec3Array& deltaV) {
+                               Vec3Array& deltaV, TaskSystem* tasks) {
   SolveReport report;
+  m_tasks = tasks;
   const Index vertexCount = A.blockRows();
   // Validated rather than asserted: the contract says a mismatch is reported, not undefined.
   if (b.size() != vertexCount || filter.size() != vertexCount) {

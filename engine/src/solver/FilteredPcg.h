@@ -44,6 +44,7 @@
 #include <solver/VertexFilter.h>
 
 #include <weft/Math.h>
+#include <weft/threading/TaskSystem.h>
 
 #include <vector>
 
@@ -94,8 +95,10 @@ class FilteredPcg {
   /// deltaV in: the previous solution when settings.warmStart (if its size differs from the
   /// vertex count it is resized to zeros and the start is cold), anything otherwise; out: the
   /// solution. Allocates only if resize() was not called with this vertex count.
+  /// `tasks` runs the sweeps over the reduction blocks (null: serial); the blocks and the order
+  /// their partial sums are combined in do not depend on it, so neither do the bits.
   SolveReport solve(const BlockSparseMatrix& A, const Vec3Array& b, const VertexFilter& filter,
-                    const PcgSettings& settings, Vec3Array& deltaV);
+                    const PcgSettings& settings, Vec3Array& deltaV, TaskSystem* tasks = nullptr);
 
  private:
   /// Runs kernel(begin, end) over the reduction blocks in order and returns the sum of the
@@ -113,6 +116,7 @@ class FilteredPcg {
   Vec3Array m_product;           ///< q = S A c
   std::vector<Mat3> m_inverseDiagonal;  ///< P̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
+  TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
 };
 
 }  // namespace weft

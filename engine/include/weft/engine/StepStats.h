@@ -39,6 +39,8 @@ struct StepStats {
   std::uint64_t frame = 0;     ///< frames stepped so far, this one included
   Real simulatedTime = 0;      ///< s, world time at the end of the frame
   Real stepMs = 0;             ///< ms of wall-clock time in step()
+  Real assemblyMs = 0;         ///< ms evaluating forces and assembling systems (all substeps)
+  Real solveMs = 0;            ///< ms in PCG solves (all substeps)
   Index substeps = 0;          ///< substeps taken (largest over cloths)
   int linearSolves = 0;        ///< PCG solves
   int cgIterations = 0;        ///< PCG iterations summed over solves

@@ -17,6 +17,7 @@
 #include <weft/engine/RenderView.h>
 #include <weft/engine/SolverSettings.h>
 #include <weft/engine/StepStats.h>
+#include <weft/threading/TaskSystem.h>
 
 #include <cstdint>
 #include <memory>
@@ -48,6 +49,12 @@ struct ClothSettings {
 struct WorldSettings {
   Vec3 gravity{0.0, -9.81, 0.0};  ///< m/s²
   Vec3 wind{0.0, 0.0, 0.0};       ///< m/s, air velocity felt through ClothMaterial::airDrag
+  /// Threads the world's loops run on, the caller's included: 0 = the machine's cores, 1 = serial.
+  /// Results are bitwise the same for every count. Ignored when taskSystem is given.
+  int threadCount = 0;
+  /// The caller's own task system (and so its oneTBB arena), which must outlive the world. Null:
+  /// the world makes one with threadCount threads. Nothing else spawns threads.
+  TaskSystem* taskSystem = nullptr;
 };
 
 class World {
@@ -97,6 +104,8 @@ class World {
 
   /// Number of live cloths.
   Index clothCount() const;
+  /// Threads the world's loops run on (1 = serial).
+  int threadCount() const;
 
  private:
   struct ClothSlot;
@@ -104,6 +113,8 @@ class World {
   ClothSlot* find(ClothId cloth);
 
   WorldSettings m_settings;
+  std::unique_ptr<TaskSystem> m_ownedTasks;  // when the caller gave none
+  TaskSystem* m_tasks = nullptr;
   std::vector<std::unique_ptr<ClothSlot>> m_slots;
   StepStats m_stats;
   Real m_time = 0;

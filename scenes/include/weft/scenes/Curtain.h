@@ -27,6 +27,8 @@ struct CurtainSettings {
   /// at the rod). A real curtain never hangs perfectly flat, and a perfectly planar one has no
   /// way to choose a side when the rod gathers it: it can only crumple in its own plane.
   Real initialWaviness = 0.005;
+  int threadCount = 0;                ///< threads of the scene's world (0 = all cores, 1 = serial)
+  TaskSystem* taskSystem = nullptr;   ///< or the caller's task system (overrides threadCount)
 };
 
 /// The curtain scene: a World with one cloth and the pin script.
