@@ -3,6 +3,7 @@
 #include "Statistics.h"
 
 #include <weft/scenes/Curtain.h>
+#include <weft/threading/Profiler.h>
 
 #if WEFT_HAVE_RENDER
 #include "RenderPipeline.h"
@@ -37,6 +38,8 @@ struct FrameRecord {
   double frameMs = 0;
   int cgIterations = 0;
   double cgResidual = 0;
+  double assemblyMs = 0;
+  double solveMs = 0;
   double maxStrain = 0;
   double kineticEnergy = 0;
   double potentialEnergy = 0;
@@ -99,7 +102,7 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
          "module" << (options.selfCollision ? " (--self-collision on is not honoured)" : "")
       << "\n";
   for (const auto& [path, isDirectory] :
-       {std::pair{options.summaryJson, false}, {options.frameCsv, false},
+       {std::pair{options.summaryJson, false}, {options.frameCsv, false}, {options.trace, false},
         {options.captureDirectory, true}}) {
     if (!prepareOutput(path, isDirectory, out)) return 2;
   }
@@ -151,6 +154,10 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   }
   out << std::flush;
 
+  if (!options.trace.empty()) {
+    Profiler::instance().registerThisThread("simulation");
+    Profiler::instance().setEnabled(true);
+  }
   std::vector<FrameRecord> records;
   records.reserve(options.frames);
   bool nonfinite = false;
@@ -170,6 +177,8 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
     const StepStats& stats = scene.world().stats();
     record.cgIterations = stats.cgIterations;
     record.cgResidual = stats.cgResidual;
+    record.assemblyMs = stats.assemblyMs;
+    record.solveMs = stats.solveMs;
     record.maxStrain = stats.maxStrain;
     record.kineticEnergy = stats.kineticEnergy;
     record.potentialEnergy = stats.potentialEnergy;
@@ -213,6 +222,8 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   const std::vector<double> simulationMs = column([](const FrameRecord& r) { return r.simulationMs; });
   const std::vector<double> frameMs = column([](const FrameRecord& r) { return r.frameMs; });
   const std::vector<double> renderMs = column([](const FrameRecord& r) { return r.renderMs; });
+  const std::vector<double> assemblyMs = column([](const FrameRecord& r) { return r.assemblyMs; });
+  const std::vector<double> solveMs = column([](const FrameRecord& r) { return r.solveMs; });
   const std::vector<double> iterations = column([](const FrameRecord& r) { return r.cgIterations; });
   double maxStrain = 0;
   unsigned unconverged = 0, unstable = 0;
@@ -229,9 +240,11 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
       << std::setprecision(3) << "  simulation ms  p50 " << percentile(simulationMs, 50) << "  p95 "
       << percentile(simulationMs, 95) << "  p99 " << percentile(simulationMs, 99) << "  max "
       << percentile(simulationMs, 100) << "\n"
-      << (rendering ? "  render ms      p50 " : "") ;
+      ;
+  out << "    assembly ms  p50 " << percentile(assemblyMs, 50) << "   solve ms p50 "
+      << percentile(solveMs, 50) << "\n";
   if (rendering) {
-    out << percentile(renderMs, 50) << "  p95 " << percentile(renderMs, 95) << "  p99 "
+    out << "  render ms      p50 " << percentile(renderMs, 50) << "  p95 " << percentile(renderMs, 95) << "  p99 "
         << percentile(renderMs, 99) << "  (draw + read back "
         << options.renderWidth << " x " << options.renderHeight << ")\n";
   }
@@ -319,17 +332,29 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
           << "'; check that the directory exists and is writable\n";
       return 1;
     }
-    file << "frame,sim_ms,render_ms,frame_ms,substeps,cg_iterations,cg_residual,max_strain,"
-            "kinetic_energy,potential_energy,status\n";
+    file << "frame,sim_ms,assembly_ms,solve_ms,render_ms,frame_ms,substeps,cg_iterations,"
+            "cg_residual,max_strain,kinetic_energy,potential_energy,status\n";
     file << std::setprecision(9);
     for (std::size_t k = 0; k < records.size(); ++k) {
       const FrameRecord& r = records[k];
-      file << k + 1 << ',' << r.simulationMs << ',' << r.renderMs << ',' << r.frameMs << ','
+      file << k + 1 << ',' << r.simulationMs << ',' << r.assemblyMs << ',' << r.solveMs << ','
+           << r.renderMs << ',' << r.frameMs << ','
            << r.substeps << ',' << r.cgIterations << ',' << r.cgResidual << ',' << r.maxStrain
            << ',' << r.kineticEnergy << ',' << r.potentialEnergy << ',' << describe(r.status)
            << '\n';
     }
     out << "  per-frame CSV  " << options.frameCsv << "\n";
+  }
+  if (!options.trace.empty()) {
+    Profiler::instance().setEnabled(false);
+    const TraceWriteResult written = Profiler::instance().writeChromeTrace(options.trace);
+    if (!written) {
+      out << "weft-curtain: " << written.error << "\n";
+      return 1;
+    }
+    out << "  trace          " << options.trace << " (" << written.eventCount << " zones"
+        << (written.droppedCount ? ", " + std::to_string(written.droppedCount) + " dropped" : "")
+        << "; open in Perfetto or chrome://tracing)\n";
   }
   return nonfinite ? 1 : 0;
 }

@@ -26,6 +26,7 @@ struct CurtainRunOptions {
   std::string captureDirectory;    ///< where PNG frames go; empty = no capture
   std::string summaryJson;         ///< JSON summary path; empty = none
   std::string frameCsv;            ///< per-frame CSV path; empty = none
+  std::string trace;               ///< Chrome trace-event JSON path (Perfetto); empty = no profiling
   IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< time integrator
   bool progress = true;            ///< print a progress line every second of simulated time
   bool overlap = true;             ///< render frame k while simulating frame k+1 (off: in turn)

@@ -1,6 +1,7 @@
 #include "RenderPipeline.h"
 
 #include <weft/render/EglContext.h>
+#include <weft/threading/Profiler.h>
 
 #include <algorithm>
 #include <chrono>
@@ -81,6 +82,7 @@ void RenderPipeline::run(RenderSettings settings) {
   }
   m_changed.notify_all();
 
+  Profiler::instance().registerThisThread("render");
   Image image;
   for (;;) {
     std::unique_lock lock(m_mutex);
@@ -94,7 +96,10 @@ void RenderPipeline::run(RenderSettings settings) {
 
     const ClothRenderView view{snapshot.positions, snapshot.normals, snapshot.indices};
     const RenderScene scene{std::span<const ClothRenderView>(&view, 1), m_colliders};
-    Result<FrameTiming> timing = renderer->renderFrame(scene, image);
+    Result<FrameTiming> timing = [&] {
+      WEFT_PROFILE_ZONE("render");
+      return renderer->renderFrame(scene, image);
+    }();
 
     lock.lock();
     m_busy = false;

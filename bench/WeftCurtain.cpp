@@ -29,6 +29,8 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_option("--summary-json", options.summaryJson, "Write the JSON summary here");
   app.add_option("--csv", options.frameCsv, "Write per-frame statistics here (CSV)");
+  app.add_option("--trace", options.trace,
+                 "Record profiler zones and write a Chrome trace here (open in Perfetto)");
   const std::map<std::string, weft::IntegratorKind> integrators{
       {"implicit-euler", weft::IntegratorKind::ImplicitEuler},
       {"explicit-euler", weft::IntegratorKind::ExplicitEuler},

@@ -270,6 +270,8 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt) {
     report.integrator.cgResidual = substepReport.cgResidual;
     report.integrator.cgConverged = report.integrator.cgConverged && substepReport.cgConverged;
     report.integrator.potentialEnergy = substepReport.potentialEnergy;
+    report.integrator.assemblyMs += substepReport.assemblyMs;
+    report.integrator.solveMs += substepReport.solveMs;
     // A cheap health check each substep: a NaN spreads through the whole mesh within one solve.
     for (const Vec3& x : m_positions) finite = finite && x.allFinite();
     for (const Vec3& v : m_velocities) finite = finite && v.allFinite();
