@@ -1,9 +1,13 @@
-// Stage benchmarks on the curtain at every size: force and matrix assembly, one SpMV, one PCG
-// solve (cold and warm started), and a whole frame. Run in Release:
+// Stage benchmarks on the curtain at every size and on 1 and 2 threads: force and matrix
+// assembly, one SpMV, one PCG solve (cold and warm started), and a whole frame. Run in Release:
 //   build/bench/weft-bench --benchmark_filter=Curtain
+// Arguments are {size, threads}; the state hash printed with the frame benchmark is the same for
+// every thread count.
 // Each fixture takes the curtain mid-motion (after a few frames of the script), so the solver
 // sees a realistic system, and prints the number of PCG iterations as a counter.
 #include "ClothForces.h"
+
+#include <weft/threading/GrainSizes.h>
 #include "solver/BlockSparseMatrix.h"
 #include "solver/FilteredPcg.h"
 #include "solver/VertexFilter.h"
@@ -51,6 +55,13 @@ struct CurtainSystem {
   }
 };
 
+TaskSystem& tasks(int threads) {
+  static std::map<int, std::unique_ptr<TaskSystem>> cache;
+  std::unique_ptr<TaskSystem>& entry = cache[threads];
+  if (!entry) entry = std::make_unique<TaskSystem>(TaskSystemSettings{threads});
+  return *entry;
+}
+
 CurtainSystem& curtain(Index size) {
   static std::map<Index, std::unique_ptr<CurtainSystem>> cache;
   std::unique_ptr<CurtainSystem>& entry = cache[size];
@@ -61,10 +72,12 @@ CurtainSystem& curtain(Index size) {
 void setCounters(benchmark::State& state, const CurtainSystem& system) {
   state.counters["triangles"] = double(system.scene->model().triangleCount());
   state.counters["blocks"] = double(system.matrix.blockCount());
+  state.counters["threads"] = double(state.range(1));
 }
 
 void CurtainAssembly(benchmark::State& state) {
   CurtainSystem& system = curtain(Index(state.range(0)));
+  system.forces->setTaskSystem(&tasks(int(state.range(1))));
   for (auto _ : state) {
     system.forces->assemble(system.x, system.v, kFrameDt, system.matrix, system.f, system.v, system.kv);
     benchmark::DoNotOptimize(system.matrix.block(0).data());
@@ -74,6 +87,7 @@ void CurtainAssembly(benchmark::State& state) {
 
 void CurtainForcesOnly(benchmark::State& state) {
   CurtainSystem& system = curtain(Index(state.range(0)));
+  system.forces->setTaskSystem(&tasks(int(state.range(1))));
   for (auto _ : state) {
     benchmark::DoNotOptimize(system.forces->computeForces(system.x, system.v, system.f));
   }
@@ -83,8 +97,12 @@ void CurtainForcesOnly(benchmark::State& state) {
 void CurtainSpmv(benchmark::State& state) {
   CurtainSystem& system = curtain(Index(state.range(0)));
   Vec3Array y(system.x.size());
+  TaskSystem& taskSystem = tasks(int(state.range(1)));
+  const Index rows = system.matrix.blockRows();
   for (auto _ : state) {
-    system.matrix.multiply(system.v, y);
+    taskSystem.parallelFor(rows, kGrainMatrixRows, [&](Index begin, Index end, int) {
+      system.matrix.multiplyRows(begin, end, system.v, y);
+    });
     benchmark::DoNotOptimize(y.data());
   }
   setCounters(state, system);
@@ -101,7 +119,8 @@ void curtainSolve(benchmark::State& state, bool warm) {
   Vec3Array solution(system.x.size(), Vec3::Zero());
   // The warm start a step would have: the solution of the same system, slightly perturbed, is
   // what the previous frame's Δv is like. Solve once to get it.
-  (void)pcg.solve(system.matrix, system.b, system.filter, settings, solution);
+  TaskSystem& taskSystem = tasks(int(state.range(1)));
+  (void)pcg.solve(system.matrix, system.b, system.filter, settings, solution, &taskSystem);
   const Vec3Array previous = solution;
   int iterations = 0;
   for (auto _ : state) {
@@ -111,7 +130,8 @@ void curtainSolve(benchmark::State& state, bool warm) {
     }
     settings.warmStart = warm;
     state.ResumeTiming();
-    const SolveReport report = pcg.solve(system.matrix, system.b, system.filter, settings, solution);
+    const SolveReport report =
+        pcg.solve(system.matrix, system.b, system.filter, settings, solution, &taskSystem);
     iterations = report.iterations;
   }
   setCounters(state, system);
@@ -124,6 +144,7 @@ void CurtainSolveWarm(benchmark::State& state) { curtainSolve(state, true); }
 void CurtainFrame(benchmark::State& state) {
   CurtainSettings settings;
   settings.size = Index(state.range(0));
+  settings.threadCount = int(state.range(1));
   CurtainScene scene = CurtainScene::create(settings).value();
   scene.stepFrame();  // drop the first step (first touch of every page)
   for (auto _ : state) {
@@ -136,11 +157,13 @@ void CurtainFrame(benchmark::State& state) {
     }
   }
   state.counters["triangles"] = double(scene.model().triangleCount());
+  state.counters["threads"] = double(state.range(1));
   state.counters["cg_iterations"] = scene.world().stats().cgIterations;
   state.counters["state_hash_low"] = double(scene.world().stateHash() & 0xffff);
 }
 
-#define WEFT_CURTAIN_SIZES ->Arg(1)->Arg(4)->Arg(16)->Arg(64)->Unit(benchmark::kMillisecond)
+#define WEFT_CURTAIN_SIZES \
+  ->ArgsProduct({{1, 4, 16, 64}, {1, 2}})->ArgNames({"size", "threads"})->Unit(benchmark::kMillisecond)
 BENCHMARK(CurtainAssembly) WEFT_CURTAIN_SIZES;
 BENCHMARK(CurtainForcesOnly) WEFT_CURTAIN_SIZES;
 BENCHMARK(CurtainSpmv) WEFT_CURTAIN_SIZES;
