@@ -1,0 +1,46 @@
+// Fabric presets: ClothMaterial values for common woven fabrics, by name.
+//
+// Every stiffness is per unit width, in the units of Material.h, so a preset works on any mesh
+// resolution. Where each number comes from is written beside it in FabricPresets.cpp; the short
+// version:
+//   - areal density: fabric weights, the Wang, Ramamoorthi & O'Brien 2011 measurement database
+//     ("Data-driven elastic models for cloth", as shipped with ARCSim) where a matching fabric
+//     exists, otherwise typical catalogue weights (g/m²);
+//   - bending and shear: Kawabata KES-F ranges (B in gf·cm²/cm, G in gf/(cm·deg)) converted to
+//     SI, 1 gf·cm²/cm = 9.80665e-5 N·m and 1 gf/(cm·deg) = 56.19 N/m per radian of shear;
+//   - stretch: the low-strain slope of the Wang et al. 2011 fits, which, like the curtain's
+//     260 N/m, is the small-load regime, far softer than the KES secant at 500 gf/cm;
+//   - damping, friction and contact thickness: engineering estimates (no measurement behind them).
+// "cotton" is exactly ClothMaterial{} — the curtain material of DESIGN.md §4 — and a test keeps it
+// so. The others are scaled estimates; treat them as starting points, not measurements.
+#pragma once
+
+#include <weft/Result.h>
+#include <weft/engine/Material.h>
+
+#include <span>
+#include <string_view>
+
+namespace weft {
+
+/// Light cotton (lawn/shirting): exactly ClothMaterial{}, the curtain material of DESIGN.md §4.
+ClothMaterial cottonFabric();
+/// Wool suiting: heavier, softer in shear, stiffer in bending than cotton.
+ClothMaterial woolFabric();
+/// Plain polyester (jacket/lining weave): light, springy in bending.
+ClothMaterial polyesterFabric();
+/// Silk (habutai/crêpe de Chine): very light and limp, low friction.
+ClothMaterial silkFabric();
+/// 11 oz denim: heavy, stiff in stretch (weft stronger than warp), bending and shear.
+ClothMaterial denimFabric();
+/// Medium linen: stiff in bending and shear for its weight.
+ClothMaterial linenFabric();
+
+/// Names accepted by fabricPreset(), lowercase: cotton, wool, polyester, silk, denim, linen.
+std::span<const std::string_view> fabricPresetNames();
+
+/// The preset of that name (ASCII case-insensitive). An unknown name fails with a message that
+/// lists the valid names.
+Result<ClothMaterial> fabricPreset(std::string_view name);
+
+}  // namespace weft

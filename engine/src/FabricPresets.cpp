@@ -1,0 +1,151 @@
+// Fabric presets. Sources and conversions, once, for every number below:
+//
+//  [W11] Wang, Ramamoorthi & O'Brien, "Data-driven elastic models for cloth: modeling and
+//        measurement", SIGGRAPH 2011: measured density (kg/m²) and piecewise-linear stretch fits
+//        of ten fabrics, as distributed with ARCSim (materials/*.json: "density", "stretching"
+//        rows C11 C12 C22 C33 per strain sample). ARCSim doubles the table when it loads it and
+//        uses E = a/2 · k0 · G00² with the Green strain G ≈ ε, so the Baraff–Witkin stiffness of
+//        Material.h (E = a/2 · k · ε²) is k ≈ 2·C11 (warp) and 2·C22 (weft) at the first sample.
+//  [KES] Kawabata KES-F low-stress measurements as reported in the textile literature (e.g. the
+//        denim table of Hindawi J. Textiles 2016, article 4614168: B = 0.14–0.23 gf·cm²/cm,
+//        G = 1.5–3.4 gf/(cm·deg); typical ranges for shirting, suiting and silk fabrics from the
+//        same literature). Conversions: B [gf·cm²/cm] × 9.80665e-5 = D [N·m];
+//        G [gf/(cm·deg)] × 0.980665 N/m × 180/π = 56.19 N/m per radian of shear, which is the
+//        shear stiffness of Material.h (E = a/2 · k · γ² for a small shear angle γ).
+//  [EST] Estimate: no measurement behind it, chosen to sit in the range of its neighbours.
+//
+// Damping is not measured by either source. Every preset keeps the curtain's Rayleigh time
+// constants (damping / stiffness: ≈ 1.9 ms stretch, 2 ms shear, 2.2 ms bending), so a preset
+// damps its own stiffness the way cotton does. Air drag is the curtain's 0.1 N·s/m³ [EST].
+// Thickness is the collision margin (ClothMaterial::thickness), not the caliper thickness of the
+// fabric (KES T ≈ 0.3–1.1 mm); it grows with the fabric's weight [EST]. Friction is the
+// cloth-on-cloth Coulomb coefficient, 0.2 (silk) to 0.35 (wool, linen, denim) [EST].
+#include <weft/engine/FabricPresets.h>
+
+#include <array>
+#include <cctype>
+#include <string>
+
+namespace weft {
+namespace {
+
+// Rayleigh time constants of the curtain material (ClothMaterial{}): damping / stiffness.
+constexpr Real kStretchDampingTime = 0.5 / 260.0;  // s
+constexpr Real kShearDampingTime = 0.2 / 100.0;    // s
+constexpr Real kBendingDampingTime = 5e-9 / 2.3e-6;  // s
+
+// gf·cm²/cm → N·m and gf/(cm·deg) → N/m per radian (see the note at the top).
+constexpr Real kBendingFromKes = 9.80665e-5;
+constexpr Real kShearFromKes = 0.980665 * 180.0 / 3.14159265358979323846;
+
+// A material from its measured (or estimated) stiffnesses, damped like the curtain.
+ClothMaterial makeFabric(Real arealDensity, Real warpStretch, Real weftStretch, Real shear,
+                         Real bending, Real friction, Real thickness) {
+  ClothMaterial material;
+  material.arealDensity = arealDensity;
+  material.warpStretchStiffness = warpStretch;
+  material.weftStretchStiffness = weftStretch;
+  material.shearStiffness = shear;
+  material.bendingStiffness = bending;
+  // Mean of warp and weft: Material.h has one stretch damping for both directions.
+  material.stretchDamping = kStretchDampingTime * 0.5 * (warpStretch + weftStretch);
+  material.shearDamping = kShearDampingTime * shear;
+  material.bendingDamping = kBendingDampingTime * bending;
+  material.friction = friction;
+  material.thickness = thickness;
+  return material;
+}
+
+constexpr std::array<std::string_view, 6> kNames{"cotton", "wool",  "polyester",
+                                                 "silk",   "denim", "linen"};
+
+bool equalsIgnoringCase(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t k = 0; k < a.size(); ++k) {
+    if (std::tolower(static_cast<unsigned char>(a[k])) !=
+        std::tolower(static_cast<unsigned char>(b[k]))) {
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+ClothMaterial cottonFabric() {
+  // DESIGN.md §4 curtain material, kept bit-identical to the defaults (a test checks it).
+  // In KES terms: 0.15 kg/m² is a 150 g/m² shirting; D = 2.3e-6 N·m is B ≈ 0.023 gf·cm²/cm (a
+  // light lawn; shirting is 0.05–0.1) [KES]; 100 N/m shear is G ≈ 1.8 gf/(cm·deg) [KES];
+  // 260 N/m stretch lies within [W11]'s low-strain slopes (2·C: 33 N/m for the cotton/polyester
+  // interlock up to 2028 N/m for the denim weft).
+  return ClothMaterial{};
+}
+
+ClothMaterial woolFabric() {
+  return makeFabric(0.25,    // kg/m²: 250 g/m² worsted suiting [EST, catalogue weight]
+                    180.0,   // N/m warp [EST]: wool crimp makes it softer in stretch than cotton
+                    150.0,   // N/m weft [EST]
+                    0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, suiting]
+                    0.10 * kBendingFromKes,   // B ≈ 0.10 gf·cm²/cm → 9.8e-6 N·m [KES, suiting]
+                    0.35,    // [EST]
+                    0.004);  // m [EST]
+}
+
+ClothMaterial polyesterFabric() {
+  return makeFabric(0.113,   // kg/m² [W11 "tango-red-jet-set", 100 % polyester jacket]
+                    86.0,    // N/m warp = 2 × 43.1 [W11, first stretch sample]
+                    343.0,   // N/m weft = 2 × 171.4 [W11, first stretch sample]
+                    0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, polyester]
+                    0.05 * kBendingFromKes,   // B ≈ 0.05 gf·cm²/cm → 4.9e-6 N·m [KES, polyester]
+                    0.25,    // [EST]
+                    0.003);  // m [EST]
+}
+
+ClothMaterial silkFabric() {
+  return makeFabric(0.06,    // kg/m²: 60 g/m² habutai / crêpe de Chine [EST, catalogue weight]
+                    200.0,   // N/m warp [EST]
+                    200.0,   // N/m weft [EST]
+                    0.4 * kShearFromKes,      // G ≈ 0.4 gf/(cm·deg) → 22 N/m [KES, silk]
+                    0.015 * kBendingFromKes,  // B ≈ 0.015 gf·cm²/cm → 1.5e-6 N·m [KES, silk]
+                    0.2,     // [EST]
+                    0.002);  // m [EST]
+}
+
+ClothMaterial denimFabric() {
+  return makeFabric(0.324,   // kg/m² [W11 "11oz-black-denim", 99 % cotton]
+                    411.0,   // N/m warp = 2 × 205.4 [W11, first stretch sample]
+                    2028.0,  // N/m weft = 2 × 1013.9 [W11, first stretch sample]
+                    2.0 * kShearFromKes,      // G ≈ 2.0 gf/(cm·deg) → 112 N/m [KES, denim 1.5–3.4]
+                    0.17 * kBendingFromKes,   // B ≈ 0.17 gf·cm²/cm → 1.7e-5 N·m [KES, 0.14–0.23]
+                    0.35,    // [EST]
+                    0.004);  // m [EST]
+}
+
+ClothMaterial linenFabric() {
+  return makeFabric(0.18,    // kg/m²: 180 g/m² dress linen [EST, catalogue weight]
+                    400.0,   // N/m warp [EST]: flax yarns extend little
+                    400.0,   // N/m weft [EST]
+                    1.6 * kShearFromKes,      // G ≈ 1.6 gf/(cm·deg) → 90 N/m [KES, linen]
+                    0.20 * kBendingFromKes,   // B ≈ 0.20 gf·cm²/cm → 2.0e-5 N·m [KES, linen]
+                    0.35,    // [EST]
+                    0.003);  // m [EST]
+}
+
+std::span<const std::string_view> fabricPresetNames() { return kNames; }
+
+Result<ClothMaterial> fabricPreset(std::string_view name) {
+  using Maker = ClothMaterial (*)();
+  constexpr std::array<Maker, kNames.size()> kMakers{cottonFabric, woolFabric,  polyesterFabric,
+                                                     silkFabric,   denimFabric, linenFabric};
+  for (std::size_t k = 0; k < kNames.size(); ++k) {
+    if (equalsIgnoringCase(name, kNames[k])) return kMakers[k]();
+  }
+  std::string valid;
+  for (std::string_view known : kNames) {
+    if (!valid.empty()) valid += ", ";
+    valid += known;
+  }
+  return Error{"fabric preset '" + std::string(name) + "' is unknown; choose one of: " + valid};
+}
+
+}  // namespace weft
