@@ -1,0 +1,155 @@
+// Point–triangle and segment–segment closest points. See Proximity.h for the design note.
+#include <weft/collision/Proximity.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace weft {
+namespace {
+
+Real clamp01(Real x) { return std::clamp(x, Real(0), Real(1)); }
+
+// Closest point on segment (a, b) to p; parameter along a → b.
+Real closestParameterOnSegment(const Vec3& p, const Vec3& a, const Vec3& b) {
+  const Vec3 ab = b - a;
+  const Real lengthSquared = ab.squaredNorm();
+  if (lengthSquared <= 0) return 0;
+  return clamp01((p - a).dot(ab) / lengthSquared);
+}
+
+TriangleClosestPoint makeResult(const Vec3& point, Real wa, Real wb, Real wc, const Vec3& a,
+                                const Vec3& b, const Vec3& c) {
+  TriangleClosestPoint result;
+  result.barycentric = Vec3(wa, wb, wc);
+  result.point = wa * a + wb * b + wc * c;
+  // Exact corners, so that a vertex contact reports the vertex itself.
+  if (wa == 1) result.point = a;
+  if (wb == 1) result.point = b;
+  if (wc == 1) result.point = c;
+  result.distance = (point - result.point).norm();
+  return result;
+}
+
+// Degenerate triangle: the closest of the three edges.
+TriangleClosestPoint closestPointOnDegenerateTriangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                                      const Vec3& c) {
+  const Real sab = closestParameterOnSegment(p, a, b);
+  const Real sbc = closestParameterOnSegment(p, b, c);
+  const Real sca = closestParameterOnSegment(p, c, a);
+  const TriangleClosestPoint onAB = makeResult(p, 1 - sab, sab, 0, a, b, c);
+  const TriangleClosestPoint onBC = makeResult(p, 0, 1 - sbc, sbc, a, b, c);
+  const TriangleClosestPoint onCA = makeResult(p, sca, 0, 1 - sca, a, b, c);
+  TriangleClosestPoint best = onAB;
+  if (onBC.distance < best.distance) best = onBC;
+  if (onCA.distance < best.distance) best = onCA;
+  return best;
+}
+
+}  // namespace
+
+TriangleClosestPoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b,
+                                            const Vec3& c) {
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  // |ab × ac|² against the longest edge⁴: below 1e-12 the triangle is a sliver whose face
+  // region cannot be computed reliably.
+  const Real areaSquared = ab.cross(ac).squaredNorm();
+  const Real longestSquared = std::max({ab.squaredNorm(), ac.squaredNorm(), (c - b).squaredNorm()});
+  if (!(areaSquared > 1e-12 * longestSquared * longestSquared)) {
+    return closestPointOnDegenerateTriangle(p, a, b, c);
+  }
+
+  // Vertex region a.
+  const Vec3 ap = p - a;
+  const Real d1 = ab.dot(ap);
+  const Real d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return makeResult(p, 1, 0, 0, a, b, c);
+  // Vertex region b.
+  const Vec3 bp = p - b;
+  const Real d3 = ab.dot(bp);
+  const Real d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return makeResult(p, 0, 1, 0, a, b, c);
+  // Edge region ab.
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
+    const Real s = d1 / (d1 - d3);
+    return makeResult(p, 1 - s, s, 0, a, b, c);
+  }
+  // Vertex region c.
+  const Vec3 cp = p - c;
+  const Real d5 = ab.dot(cp);
+  const Real d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return makeResult(p, 0, 0, 1, a, b, c);
+  // Edge region ac.
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
+    const Real s = d2 / (d2 - d6);
+    return makeResult(p, 1 - s, 0, s, a, b, c);
+  }
+  // Edge region bc.
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    const Real s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return makeResult(p, 0, 1 - s, s, a, b, c);
+  }
+  // Face region: va, vb, vc are the (scaled) barycentric weights.
+  const Real inverse = 1 / (va + vb + vc);
+  const Real wb = vb * inverse;
+  const Real wc = vc * inverse;
+  return makeResult(p, 1 - wb - wc, wb, wc, a, b, c);
+}
+
+SegmentClosestPoints closestPointsOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0,
+                                             const Vec3& q1) {
+  const Vec3 d1 = p1 - p0;
+  const Vec3 d2 = q1 - q0;
+  const Vec3 r = p0 - q0;
+  const Real a = d1.squaredNorm();
+  const Real e = d2.squaredNorm();
+  const Real f = d2.dot(r);
+  Real s = 0;
+  Real u = 0;
+  if (a <= 0 && e <= 0) {
+    // Two points.
+  } else if (a <= 0) {
+    u = clamp01(f / e);
+  } else if (e <= 0) {
+    s = clamp01(-d1.dot(r) / a);
+  } else {
+    const Real b = d1.dot(d2);
+    const Real c = d1.dot(r);
+    const Real denominator = a * e - b * b;  // = |d1 × d2|², ≥ 0
+    if (denominator > 1e-12 * a * e) {
+      s = clamp01((b * f - c * e) / denominator);
+    } else {
+      // Parallel: s at the middle of the overlap of q's projection onto p's line, or at the
+      // nearer end of p when they do not overlap.
+      const Real sAtQ0 = -c / a;
+      const Real sAtQ1 = (b - c) / a;
+      const Real low = std::max(Real(0), std::min(sAtQ0, sAtQ1));
+      const Real high = std::min(Real(1), std::max(sAtQ0, sAtQ1));
+      if (low <= high) {
+        s = 0.5 * (low + high);
+      } else {
+        s = std::max(sAtQ0, sAtQ1) < 0 ? 0 : 1;
+      }
+    }
+    u = (b * s + f) / e;
+    if (u < 0) {
+      u = 0;
+      s = clamp01(-c / a);
+    } else if (u > 1) {
+      u = 1;
+      s = clamp01((b - c) / a);
+    }
+  }
+  SegmentClosestPoints result;
+  result.firstParameter = s;
+  result.secondParameter = u;
+  result.pointOnFirst = p0 + s * d1;
+  result.pointOnSecond = q0 + u * d2;
+  result.distance = (result.pointOnFirst - result.pointOnSecond).norm();
+  return result;
+}
+
+}  // namespace weft
