@@ -15,7 +15,7 @@
 // Wall time is measured around World::step only, in the same run, and given per simulated second;
 // with --repeat N the fastest of N identical runs is kept (the machine is shared: noise is real).
 // Runs whose step reported Unstable or RolledBack are kept in the CSV, flagged, and left out of
-// the Pareto front. A run that rolled back stops there: its state no longer moves.
+// the Pareto front; such a run stops at the first flagged frame (its errors are then n/a).
 //
 // What the reference is not: backward Euler is first order, so the reference itself is off from
 // the exact solution by O(h_ref). Errors far below the reference's own error (higher-order
@@ -129,7 +129,9 @@ RunResult runCurtain(const SweepConfig& config, const std::vector<Index>& sample
     result.status |= status;
     cgIterations += world.stats().cgIterations;
     result.framesRun = frame;
-    if (hasFlag(status, StepStatus::RolledBack)) break;  // the state is frozen from here on
+    // Unstable or rolled back: the run is out of the front whatever follows, so stop here (the
+    // engine's retries make an unstable run slow, and a rolled-back state no longer moves).
+    if (hasFlag(status, StepStatus::Unstable) || hasFlag(status, StepStatus::RolledBack)) break;
     if (frame == sampleFrames[nextSample]) {
       Sample sample;
       sample.frame = frame;
