@@ -37,7 +37,8 @@ RenderPipeline::~RenderPipeline() {
   if (m_thread.joinable()) m_thread.join();
 }
 
-double RenderPipeline::publish(unsigned frame, const ClothRenderView& view) {
+double RenderPipeline::publish(unsigned frame, const ClothRenderView& view,
+                               std::span<const ColliderPrimitive> movingColliders) {
   const auto start = std::chrono::steady_clock::now();
   std::unique_lock lock(m_mutex);
   // One frame in flight at most: wait until the previous one has been taken and drawn.
@@ -51,6 +52,8 @@ double RenderPipeline::publish(unsigned frame, const ClothRenderView& view) {
   if (snapshot.indices.size() != view.indices.size()) {
     snapshot.indices.assign(view.indices.begin(), view.indices.end());
   }
+  snapshot.colliders.assign(m_colliders.begin(), m_colliders.end());
+  snapshot.colliders.insert(snapshot.colliders.end(), movingColliders.begin(), movingColliders.end());
   snapshot.frame = frame;
   m_pending = true;
   lock.unlock();
@@ -95,7 +98,7 @@ void RenderPipeline::run(RenderSettings settings) {
     lock.unlock();
 
     const ClothRenderView view{snapshot.positions, snapshot.normals, snapshot.indices};
-    const RenderScene scene{std::span<const ClothRenderView>(&view, 1), m_colliders};
+    const RenderScene scene{std::span<const ClothRenderView>(&view, 1), snapshot.colliders};
     Result<FrameTiming> timing = [&] {
       WEFT_PROFILE_ZONE("render");
       return renderer->renderFrame(scene, image);

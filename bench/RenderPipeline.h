@@ -34,7 +34,8 @@ class RenderPipeline {
 
   /// Hands frame `frame` to the render thread (copying the view), waiting first until the
   /// previous frame has been drawn. Returns the ms spent waiting.
-  double publish(unsigned frame, const ClothRenderView& view);
+  double publish(unsigned frame, const ClothRenderView& view,
+                 std::span<const ColliderPrimitive> movingColliders = {});
   /// Waits until every published frame has been drawn.
   void drain();
 
@@ -54,6 +55,7 @@ class RenderPipeline {
   struct Snapshot {
     Vec3Array positions, normals;
     std::vector<Index> indices;
+    std::vector<ColliderPrimitive> colliders;  // the static ones, then this frame's moving ones
     unsigned frame = 0;
   };
   Snapshot m_snapshot;

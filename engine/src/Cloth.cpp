@@ -14,6 +14,12 @@ namespace {
 constexpr Real kExplicitGrowthPerStep = 1e-6;
 // Safety factor on the stable-step estimate (it is an upper bound of ω, but at the rest state).
 constexpr Real kStableStepSafety = 0.9;
+// A vertex faster than this (m/s) means the integration diverged: no cloth motion comes near
+// it (a 250 m/s projectile drags cloth at 250 m/s), while a blown-up explicit step passes it
+// within a few substeps.
+constexpr Real kDivergedSpeed = 1e4;
+// Retries of a failed frame, each with twice the substeps: up to 8 times the planned number.
+constexpr int kMaxRetries = 3;
 
 std::string checkNonNegative(const char* field, Real value, const char* unit) {
   if (std::isfinite(value) && value >= 0) return {};
@@ -126,10 +132,16 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
     m_pinnedSorted.push_back(pins[k]);
     m_pinSlotOfSorted.push_back(k);
   }
+  m_pinnedMask.assign(n, 0);
+  for (Index p : pins) m_pinnedMask[p] = 1;
   m_pinStart.resize(pins.size());
   for (std::size_t k = 0; k < pins.size(); ++k) m_pinStart[k] = m_positions[pins[k]];
   m_pinEnd = m_pinStart;
 
+  m_inverseMasses.resize(n);
+  const std::vector<Real>& mass = m_forces.masses();
+  for (Index i = 0; i < n; ++i) m_inverseMasses[i] = m_pinnedMask[i] ? 0 : 1 / mass[i];
+  if (settings.selfCollision) m_selfCollision = std::make_unique<SelfCollision>(*m_model);
   estimateStiffestMode();
 }
 
@@ -250,21 +262,44 @@ Status Cloth::setState(std::span<const Vec3> positions, std::span<const Vec3> ve
   return Status::success();
 }
 
-ClothFrameReport Cloth::stepFrame(Real t, Real frameDt) {
-  ClothFrameReport report;
-  bool predictedUnstable = false;
-  report.substeps = plannedSubsteps(frameDt, &predictedUnstable);
-  if (predictedUnstable) report.status |= StepStatus::Unstable;
+void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
+                              VertexFilter& filter) {
+  m_colliderResponse.constrain(m_colliders, x, v, h, m_settings.material.thickness, m_pinnedMask,
+                               filter);
+}
 
-  m_savedPositions = m_positions;
-  m_savedVelocities = m_velocities;
-  m_frameStart = t;
-  m_frameLength = frameDt;
-  const Real h = frameDt / report.substeps;
-  bool finite = true;
-  for (Index substep = 0; substep < report.substeps && finite; ++substep) {
+bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
+                        ClothFrameReport& report) {
+  const Real h = frameDt / substeps;
+  const RigidMotion* frameStart = m_frameStartMotions.data();
+  for (Index substep = 0; substep < substeps; ++substep) {
     IntegratorReport substepReport;
+    for (std::size_t k = 0; k < colliders.size(); ++k) {
+      colliders[k].start = advanceMotion(frameStart[k], substep * h);
+      colliders[k].end = advanceMotion(frameStart[k], (substep + 1) * h);
+      (void)setMotion(*colliders[k].shape, colliders[k].end);
+    }
+    m_colliders = colliders;
+    if (!colliders.empty() || m_selfCollision) {
+      m_stepStartPositions = m_positions;
+      m_stepStartVelocities = m_velocities;
+    }
     m_integrator->step(*this, m_positions, m_velocities, t + substep * h, h, substepReport);
+    if (!colliders.empty()) {
+      const ColliderResponseReport contact = m_colliderResponse.resolve(
+          colliders, m_stepStartPositions, m_stepStartVelocities, m_settings.material.thickness,
+          m_pinnedMask, m_positions, m_velocities);
+      report.contacts = contact.contacts;
+    }
+    if (m_selfCollision) {
+      const SelfCollisionReport self = m_selfCollision->resolve(
+          m_stepStartPositions, h, m_settings.material.thickness, m_settings.material.friction,
+          m_inverseMasses, m_positions, m_velocities);
+      report.selfCollision.proximityContacts += self.proximityContacts;
+      report.selfCollision.impacts += self.impacts;
+      report.selfCollision.impactZones += self.impactZones;
+      report.selfCollision.frozenVertices += self.frozenVertices;
+    }
     report.integrator.linearSolves += substepReport.linearSolves;
     report.integrator.cgIterations += substepReport.cgIterations;
     report.integrator.cgResidual = substepReport.cgResidual;
@@ -272,18 +307,70 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt) {
     report.integrator.potentialEnergy = substepReport.potentialEnergy;
     report.integrator.assemblyMs += substepReport.assemblyMs;
     report.integrator.solveMs += substepReport.solveMs;
-    // A cheap health check each substep: a NaN spreads through the whole mesh within one solve.
-    for (const Vec3& x : m_positions) finite = finite && x.allFinite();
-    for (const Vec3& v : m_velocities) finite = finite && v.allFinite();
+    // A cheap health check each substep: a NaN spreads through the whole mesh within one solve,
+    // and a diverging explicit method passes any physical speed within a few substeps.
+    bool healthy = true;
+    for (const Vec3& x : m_positions) healthy = healthy && x.allFinite();
+    for (const Vec3& v : m_velocities) {
+      healthy = healthy && v.allFinite() && v.squaredNorm() < kDivergedSpeed * kDivergedSpeed;
+    }
+    if (!healthy) return false;
   }
-  if (!report.integrator.cgConverged) report.status |= StepStatus::SolverNotConverged;
-  if (!finite) {
-    // Never hand NaN to the caller: undo the frame, forget warm-start data, report.
+  return true;
+}
+
+void Cloth::save(SavedState& out) const {
+  out.positions = m_positions;
+  out.velocities = m_velocities;
+  out.pinTargets = m_pinEnd;
+  m_integrator->saveCarriedState(out.carried);
+}
+
+void Cloth::restore(const SavedState& in) {
+  m_positions = in.positions;
+  m_velocities = in.velocities;
+  m_pinStart = m_pinEnd = in.pinTargets;
+  m_integrator->restoreCarriedState(in.carried);
+  m_normalsValid = false;
+}
+
+ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame> colliders) {
+  ClothFrameReport report;
+  bool predictedUnstable = false;
+  Index substeps = plannedSubsteps(frameDt, &predictedUnstable);
+  if (predictedUnstable) report.status |= StepStatus::Unstable;
+
+  m_savedPositions = m_positions;
+  m_savedVelocities = m_velocities;
+  m_frameStart = t;
+  m_frameLength = frameDt;
+  // The friction of a pair is the geometric mean of the two coefficients.
+  for (ColliderFrame& collider : colliders) {
+    collider.friction = std::sqrt(std::max<Real>(0, collider.friction) * m_settings.material.friction);
+  }
+  m_frameStartMotions.clear();  // keeps its capacity: no allocation once colliders are known
+  for (const ColliderFrame& collider : colliders) m_frameStartMotions.push_back(collider.start);
+
+  // Health monitor: a frame that ends non-finite or diverging is undone and retried with twice
+  // as many substeps, up to kMaxRetries times; if it still fails, the cloth stays where the frame
+  // started. Either way the caller hears of it and never sees a NaN.
+  for (int attempt = 0;; ++attempt) {
+    report.substeps = substeps;
+    report.integrator = IntegratorReport{};
+    if (runSubsteps(t, frameDt, substeps, colliders, report)) break;
     m_positions = m_savedPositions;
     m_velocities = m_savedVelocities;
-    m_integrator->reset();
-    report.status |= StepStatus::RolledBack | StepStatus::Unstable;
+    m_integrator->reset();  // the failed attempt's Δv is no warm start
+    report.status |= StepStatus::Unstable;
+    if (attempt == kMaxRetries) {
+      report.status |= StepStatus::RolledBack;
+      break;
+    }
+    report.status |= StepStatus::RetriedWithSmallerStep;
+    substeps *= 2;
   }
+  m_colliders = {};
+  if (!report.integrator.cgConverged) report.status |= StepStatus::SolverNotConverged;
   m_pinStart = m_pinEnd;  // next frame starts where this one ended
   m_normalsValid = false;
   return report;

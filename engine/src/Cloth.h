@@ -6,6 +6,8 @@
 #pragma once
 
 #include "ClothForces.h"
+#include "ColliderResponse.h"
+#include "SelfCollision.h"
 #include "integrators/Integrator.h"
 #include "solver/BlockSparseMatrix.h"
 
@@ -18,6 +20,8 @@ namespace weft {
 /// Result of advancing one cloth by one frame.
 struct ClothFrameReport {
   Index substeps = 0;
+  SelfCollisionReport selfCollision;  ///< summed over substeps
+  Index contacts = 0;  ///< vertices touching colliders at the end of the frame
   IntegratorReport integrator;
   StepStatus status = StepStatus::Ok;
 };
@@ -39,9 +43,13 @@ class Cloth final : public DynamicSystem {
   std::span<const Index> prescribedVertices() const override { return m_pinnedSorted; }
   void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const override;
   TaskSystem* taskSystem() override { return m_tasks; }
+  void constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
+                         VertexFilter& filter) override;
 
-  /// Advances by one frame of length frameDt starting at world time t.
-  ClothFrameReport stepFrame(Real t, Real frameDt);
+  /// Advances by one frame of length frameDt starting at world time t, against colliders whose
+  /// motions are given at the frame start (their shapes are posed per substep and left posed at
+  /// the end of the last substep).
+  ClothFrameReport stepFrame(Real t, Real frameDt, std::span<ColliderFrame> colliders = {});
   /// Substeps this cloth takes for a frame of frameDt; `predictedUnstable` is set when an
   /// explicit method would need more than maxSubsteps.
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
@@ -56,6 +64,14 @@ class Cloth final : public DynamicSystem {
   const ClothSettings& settings() const { return m_settings; }
 
   Status setState(std::span<const Vec3> positions, std::span<const Vec3> velocities);
+
+  /// Everything that decides how this cloth continues (see World::saveState).
+  struct SavedState {
+    Vec3Array positions, velocities, pinTargets, carried;
+  };
+  void save(SavedState& out) const;
+  /// Restores a save of this cloth (sizes checked by the caller).
+  void restore(const SavedState& in);
   /// Largest stretch l / l_rest − 1 over mesh edges (0 when nothing is stretched).
   Real maxStrain() const;
   /// J, Σ ½ m v².
@@ -73,6 +89,9 @@ class Cloth final : public DynamicSystem {
   Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
         const WorldSettings& world, std::vector<Real> masses, TaskSystem* tasks);
   void estimateStiffestMode();
+  // Runs `substeps` substeps of the frame; false when the state became non-finite or diverged.
+  bool runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
+                   ClothFrameReport& report);
 
   std::shared_ptr<const ClothModel> m_model;
   TaskSystem* m_tasks;
@@ -87,6 +106,13 @@ class Cloth final : public DynamicSystem {
   Vec3Array m_savedPositions, m_savedVelocities;
 
   std::vector<Index> m_pinnedSorted;   // pinned vertices, increasing
+  std::vector<char> m_pinnedMask;      // 1 for pinned vertices
+  ColliderResponse m_colliderResponse;
+  std::unique_ptr<SelfCollision> m_selfCollision;  // null when ClothSettings::selfCollision is off
+  std::vector<Real> m_inverseMasses;               // 0 for pinned vertices
+  std::span<const ColliderFrame> m_colliders;  // this substep's colliders
+  Vec3Array m_stepStartPositions, m_stepStartVelocities;
+  std::vector<RigidMotion> m_frameStartMotions;
   std::vector<Index> m_pinSlotOfSorted;  // index into settings.pinnedVertices for each sorted pin
   Vec3Array m_pinStart, m_pinEnd;      // targets at frame start and end, in settings order
   Real m_frameStart = 0, m_frameLength = 1;

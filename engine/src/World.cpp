@@ -7,6 +7,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <optional>
 
 namespace weft {
 
@@ -22,6 +23,7 @@ std::string describe(StepStatus status) {
   add(StepStatus::SolverNotConverged, "solver-not-converged");
   add(StepStatus::RolledBack, "rolled-back");
   add(StepStatus::InvalidInput, "invalid-input");
+  add(StepStatus::RetriedWithSmallerStep, "retried-with-smaller-step");
   return text;
 }
 
@@ -29,6 +31,29 @@ struct World::ClothSlot {
   std::unique_ptr<Cloth> cloth;  // null when free
   std::uint32_t generation = 1;
 };
+
+struct World::ColliderSlot {
+  std::optional<Shape> shape;  // empty when free
+  ColliderSettings settings;
+  std::uint32_t generation = 1;
+};
+
+struct WorldState::Data {
+  Real time = 0;
+  std::uint64_t frame = 0;
+  std::vector<std::pair<ClothId, Cloth::SavedState>> cloths;
+  std::vector<std::pair<ColliderId, RigidMotion>> colliders;
+};
+
+WorldState::WorldState() : m_data(std::make_unique<Data>()) {}
+WorldState::~WorldState() = default;
+WorldState::WorldState(const WorldState& other) : m_data(std::make_unique<Data>(*other.m_data)) {}
+WorldState& WorldState::operator=(const WorldState& other) {
+  *m_data = *other.m_data;
+  return *this;
+}
+WorldState::WorldState(WorldState&&) noexcept = default;
+WorldState& WorldState::operator=(WorldState&&) noexcept = default;
 
 World::World(const WorldSettings& settings) : m_settings(settings) {
   if (settings.taskSystem) {
@@ -52,6 +77,16 @@ const World::ClothSlot* World::find(ClothId id) const {
 
 World::ClothSlot* World::find(ClothId id) {
   return const_cast<ClothSlot*>(static_cast<const World*>(this)->find(id));
+}
+
+const World::ColliderSlot* World::find(ColliderId id) const {
+  if (id.index == 0 || id.index > m_colliderSlots.size()) return nullptr;
+  const ColliderSlot* slot = m_colliderSlots[id.index - 1].get();
+  return (slot->shape && slot->generation == id.generation) ? slot : nullptr;
+}
+
+World::ColliderSlot* World::find(ColliderId id) {
+  return const_cast<ColliderSlot*>(static_cast<const World*>(this)->find(id));
 }
 
 namespace {
@@ -79,6 +114,52 @@ Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
   m_slots.push_back(std::make_unique<ClothSlot>());
   m_slots.back()->cloth = std::move(cloth.value());
   return ClothId{std::uint32_t(m_slots.size()), m_slots.back()->generation};
+}
+
+Result<ColliderId> World::addCollider(const Shape& shape, const ColliderSettings& settings) {
+  if (!(std::isfinite(settings.friction) && settings.friction >= 0)) {
+    return Error{"addCollider: friction = " + std::to_string(settings.friction) +
+                 " must be finite and at least 0"};
+  }
+  for (std::size_t k = 0; k < m_colliderSlots.size(); ++k) {
+    if (!m_colliderSlots[k]->shape) {
+      m_colliderSlots[k]->shape = shape;
+      m_colliderSlots[k]->settings = settings;
+      return ColliderId{std::uint32_t(k + 1), m_colliderSlots[k]->generation};
+    }
+  }
+  m_colliderSlots.push_back(std::make_unique<ColliderSlot>());
+  m_colliderSlots.back()->shape = shape;
+  m_colliderSlots.back()->settings = settings;
+  return ColliderId{std::uint32_t(m_colliderSlots.size()), m_colliderSlots.back()->generation};
+}
+
+namespace {
+Error staleCollider(const char* operation, ColliderId id) {
+  return Error{std::string(operation) + ": collider handle {" + std::to_string(id.index) + ", " +
+               std::to_string(id.generation) +
+               "} is null or refers to a destroyed collider; use the handle addCollider() returned"};
+}
+}  // namespace
+
+Status World::destroyCollider(ColliderId id) {
+  ColliderSlot* slot = find(id);
+  if (!slot) return staleCollider("destroyCollider", id);
+  slot->shape.reset();
+  ++slot->generation;
+  return Status::success();
+}
+
+Status World::setColliderMotion(ColliderId id, const RigidMotion& motion) {
+  ColliderSlot* slot = find(id);
+  if (!slot) return staleCollider("setColliderMotion", id);
+  return setMotion(*slot->shape, motion);
+}
+
+Result<const Shape*> World::collider(ColliderId id) const {
+  const ColliderSlot* slot = find(id);
+  if (!slot) return staleCollider("collider", id);
+  return &*slot->shape;
 }
 
 Status World::destroyCloth(ClothId id) {
@@ -118,10 +199,30 @@ StepStatus World::step(Real frameDt) {
   }
   StepStats stats;
   stats.frame = m_stats.frame + 1;
+  // Where the colliders are at the frame start; each cloth steps against them from there (a
+  // cloth poses the shapes per substep), and they end the frame advanced by their velocities.
+  m_colliderStartMotions.clear();
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (collider->shape) m_colliderStartMotions.push_back(motion(*collider->shape));
+  }
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
     if (!slot->cloth) continue;
     Cloth& cloth = *slot->cloth;
-    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt);
+    m_colliderFrames.clear();
+    std::size_t k = 0;
+    for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+      if (!collider->shape) continue;
+      ColliderFrame frame;
+      frame.shape = &*collider->shape;
+      frame.start = frame.end = m_colliderStartMotions[k++];
+      frame.friction = collider->settings.friction;
+      m_colliderFrames.push_back(frame);
+    }
+    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames);
+    stats.contacts += report.contacts;
+    stats.selfContacts += report.selfCollision.proximityContacts;
+    stats.selfImpacts += report.selfCollision.impacts;
+    stats.impactZones += report.selfCollision.impactZones;
     stats.status |= report.status;
     stats.substeps = std::max(stats.substeps, report.substeps);
     stats.linearSolves += report.integrator.linearSolves;
@@ -133,6 +234,11 @@ StepStatus World::step(Real frameDt) {
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxStrain = std::max(stats.maxStrain, cloth.maxStrain());
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
+  }
+  std::size_t k = 0;
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (!collider->shape) continue;
+    (void)setMotion(*collider->shape, advanceMotion(m_colliderStartMotions[k++], frameDt));
   }
   m_time += frameDt;
   stats.simulatedTime = m_time;
@@ -168,6 +274,47 @@ Result<Index> World::plannedSubsteps(ClothId id, Real frameDt) const {
     return Error{"plannedSubsteps: frameDt must be finite and greater than 0 s"};
   }
   return slot->cloth->plannedSubsteps(frameDt);
+}
+
+WorldState World::saveState() const {
+  WorldState state;
+  state.m_data->time = m_time;
+  state.m_data->frame = m_stats.frame;
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    if (!m_slots[k]->cloth) continue;
+    state.m_data->cloths.emplace_back(ClothId{std::uint32_t(k + 1), m_slots[k]->generation},
+                                      Cloth::SavedState{});
+    m_slots[k]->cloth->save(state.m_data->cloths.back().second);
+  }
+  for (std::size_t k = 0; k < m_colliderSlots.size(); ++k) {
+    if (!m_colliderSlots[k]->shape) continue;
+    state.m_data->colliders.emplace_back(
+        ColliderId{std::uint32_t(k + 1), m_colliderSlots[k]->generation},
+        motion(*m_colliderSlots[k]->shape));
+  }
+  return state;
+}
+
+Status World::restoreState(const WorldState& state) {
+  // Check everything first, so a failed restore changes nothing.
+  for (const auto& [id, saved] : state.m_data->cloths) {
+    const ClothSlot* slot = find(id);
+    if (!slot) return staleHandle("restoreState: the saved cloth", id);
+    if (saved.positions.size() != slot->cloth->vertexCount()) {
+      return Error{"restoreState: cloth {" + std::to_string(id.index) + ", " +
+                   std::to_string(id.generation) + "} no longer has the saved vertex count"};
+    }
+  }
+  for (const auto& [id, saved] : state.m_data->colliders) {
+    if (!find(id)) return staleCollider("restoreState: the saved collider", id);
+  }
+  for (const auto& [id, saved] : state.m_data->cloths) find(id)->cloth->restore(saved);
+  for (const auto& [id, saved] : state.m_data->colliders) (void)setMotion(*find(id)->shape, saved);
+  m_time = state.m_data->time;
+  m_stats = StepStats{};
+  m_stats.frame = state.m_data->frame;
+  m_stats.simulatedTime = m_time;
+  return Status::success();
 }
 
 std::uint64_t World::stateHash() const {

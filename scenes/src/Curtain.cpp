@@ -29,6 +29,14 @@ Vec3 CurtainScene::pinTarget(const Vec3& restPosition, Real t) {
   return Vec3(-1 + (restPosition.x() + 1) * scale, restPosition.y(), restPosition.z());
 }
 
+Vec3 CurtainScene::spherePosition(Real t) {
+  // Behind the curtain at z = −0.5; in to z = +0.3 between 1 and 2 s, back out by 3 s.
+  Real pushed = 0;
+  if (t > 1 && t <= 2) pushed = smoothstep(t - 1);
+  else if (t > 2 && t <= 3) pushed = 1 - smoothstep(t - 2);
+  return Vec3(0.3, 1.1, -0.5 + 0.8 * pushed);
+}
+
 Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   if (settings.size != 1 && settings.size != 4 && settings.size != 16 && settings.size != 64) {
     return Error{"curtain size " + std::to_string(settings.size) +
@@ -53,6 +61,7 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   cloth.forceModel = settings.forceModel;
   cloth.material = settings.material;
   cloth.solver = settings.solver;
+  cloth.selfCollision = settings.selfCollision;
   const Index topRow = grid.rows - 1;
   for (Index column = 0; column < grid.columns; ++column) {
     cloth.pinnedVertices.push_back(topRow * grid.columns + column);
@@ -64,6 +73,21 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   Result<ClothId> id = scene.m_world->createCloth(scene.m_model, cloth);
   if (!id.ok()) return id.error();
   scene.m_cloth = id.value();
+
+  if (settings.sphere) {
+    RigidMotion start;
+    start.pose.position = spherePosition(0);
+    Result<Sphere> sphere = Sphere::create(kSphereRadius, start);
+    if (!sphere.ok()) return sphere.error();
+    Result<ColliderId> sphereId = scene.m_world->addCollider(sphere.value());
+    if (!sphereId.ok()) return sphereId.error();
+    scene.m_sphere = sphereId.value();
+    Result<Plane> floor = Plane::create(Vec3(0, 1, 0));
+    if (!floor.ok()) return floor.error();
+    Result<ColliderId> floorId = scene.m_world->addCollider(floor.value());
+    if (!floorId.ok()) return floorId.error();
+    scene.m_floor = floorId.value();
+  }
 
   if (settings.initialWaviness != 0) {
     if (!std::isfinite(settings.initialWaviness)) {
@@ -90,6 +114,13 @@ StepStatus CurtainScene::stepFrame() {
     for (std::size_t k = 0; k < m_pinRest.size(); ++k) m_targets[k] = pinTarget(m_pinRest[k], endTime);
     // Cannot fail: one finite target per pin, on a live handle.
     (void)m_world->setPinTargets(m_cloth, m_targets);
+  }
+  if (!m_sphere.isNull()) {
+    // Velocity that brings the sphere where the script wants it at the end of the frame.
+    const Real endTime = (m_frame + 1) * kFrameDt;
+    RigidMotion sphereMotion = motion(*m_world->collider(m_sphere).value());
+    sphereMotion.linearVelocity = (spherePosition(endTime) - sphereMotion.pose.position) / kFrameDt;
+    (void)m_world->setColliderMotion(m_sphere, sphereMotion);
   }
   ++m_frame;
   return m_world->step(kFrameDt);

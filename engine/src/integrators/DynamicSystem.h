@@ -8,6 +8,7 @@
 #pragma once
 
 #include "solver/BlockSparseMatrix.h"
+#include "solver/VertexFilter.h"
 
 #include <weft/Math.h>
 #include <weft/threading/TaskSystem.h>
@@ -43,6 +44,13 @@ class DynamicSystem {
   /// Writes the prescribed position (m) and velocity (m/s) at time t into x and v for every
   /// prescribed vertex; leaves the others untouched.
   virtual void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const = 0;
+
+  /// Adds contact constraints to the implicit solve's filter for a step of length h from (x, v)
+  /// (Baraff & Witkin §5.3), releasing the previous step's first. Default: no contacts.
+  virtual void constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
+                                 VertexFilter& filter) {
+    (void)x, (void)v, (void)h, (void)filter;
+  }
 
   /// Where the integrator may run its own parallel loops (the linear solve); null: serial.
   virtual TaskSystem* taskSystem() { return nullptr; }

@@ -10,6 +10,21 @@ namespace weft {
 
 void ImplicitEuler::reset() { m_hasWarmStart = false; }
 
+void ImplicitEuler::saveCarriedState(Vec3Array& out) const {
+  if (m_hasWarmStart) out = m_deltaV;
+  else out.clear();
+}
+
+void ImplicitEuler::restoreCarriedState(const Vec3Array& in) {
+  if (in.empty()) {
+    reset();
+    return;
+  }
+  resize(Index(in.size()));
+  m_deltaV = in;
+  m_hasWarmStart = true;
+}
+
 void ImplicitEuler::resize(Index vertexCount) {
   if (m_deltaV.size() == vertexCount) return;
   m_pcg.resize(vertexCount);
@@ -53,6 +68,8 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   for (Index vertex : m_filteredVertices) {
     m_filter.setFixed(vertex, (m_prescribedPosition[vertex] - x[vertex]) / h - v[vertex]);
   }
+  // Contacts with colliders: one constrained direction each.
+  system.constrainContacts(x, v, h, m_filter);
 
   // Baraff–Witkin step, expanded about (x_n, v_n).
   {
@@ -74,6 +91,12 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   // Newton iterations on M Δv = h f(x_n + h(v_n + Δv), v_n + Δv); pinned vertices stay on target.
   if (m_settings.newtonIterations > 0) {
     for (Index vertex : m_filteredVertices) m_filter.setFixed(vertex, Vec3::Zero());
+    // Contact constraints are met by Δv already: corrections stay tangent to the contacts.
+    for (Index vertex = 0; vertex < n; ++vertex) {
+      if (m_filter.kind(vertex) == ConstraintKind::OneDirection) {
+        m_filter.setConstrained(vertex, m_filter.direction(vertex, 0), Vec3::Zero());
+      }
+    }
   }
   for (int iteration = 0; iteration < m_settings.newtonIterations; ++iteration) {
     for (Index i = 0; i < n; ++i) {

@@ -31,6 +31,8 @@ class ImplicitEuler final : public Integrator {
   void step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
             IntegratorReport& report) override;
   void reset() override;
+  void saveCarriedState(Vec3Array& out) const override;
+  void restoreCarriedState(const Vec3Array& in) override;
 
  private:
   void resize(Index vertexCount);

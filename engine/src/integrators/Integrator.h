@@ -41,6 +41,12 @@ class Integrator {
                     IntegratorReport& report) = 0;
   /// Forgets warm-start data (after a teleport or a restore).
   virtual void reset() {}
+  /// State carried from one step to the next that changes results (the implicit method's Δv
+  /// warm start): saved and restored with the world so a restored world continues bit for bit.
+  /// Empty when the method carries none.
+  virtual void saveCarriedState(Vec3Array& out) const { out.clear(); }
+  /// Restores what saveCarriedState() wrote (an empty array = no carried state).
+  virtual void restoreCarriedState(const Vec3Array& in) { (void)in; reset(); }
 };
 
 /// Largest step h (s) at which `kind` keeps a damped linear mode ẍ = −ω² x − c ẋ from growing by

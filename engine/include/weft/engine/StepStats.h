@@ -17,10 +17,14 @@ enum class StepStatus : std::uint32_t {
   /// A PCG solve stopped at cgMaxIterations before cgTolerance: raise cgMaxIterations or
   /// cgTolerance, or take smaller steps.
   SolverNotConverged = 1u << 1,
-  /// The state became non-finite; the cloth was restored to its state before the frame.
+  /// The frame failed even with 8× the substeps; the cloth was restored to its state before the
+  /// frame (it did not move this frame).
   RolledBack = 1u << 2,
   /// The step was refused (bad frameDt); nothing changed.
   InvalidInput = 1u << 3,
+  /// A frame went non-finite or diverged and was redone with more substeps (up to 8×); see
+  /// StepStats::substeps. Lower the stiffness or the frame length if it keeps happening.
+  RetriedWithSmallerStep = 1u << 4,
 };
 
 constexpr StepStatus operator|(StepStatus a, StepStatus b) {
@@ -51,6 +55,10 @@ struct StepStats {
   Real kineticEnergy = 0;      ///< J at the end of the frame
   Real potentialEnergy = 0;    ///< J (elastic + gravity) at the start of the last substep
   Real maxSpeed = 0;           ///< m/s, fastest vertex at the end
+  Index contacts = 0;          ///< cloth vertices touching a collider at the end
+  Index selfContacts = 0;      ///< self-proximity pairs repelled (all substeps)
+  Index selfImpacts = 0;       ///< swept self-collisions resolved by impulses (all substeps)
+  Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
   StepStatus status = StepStatus::Ok;  ///< the flags step() returned
 };
 

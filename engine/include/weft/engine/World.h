@@ -12,6 +12,7 @@
 
 #include <weft/Math.h>
 #include <weft/Result.h>
+#include <weft/collision/Shape.h>
 #include <weft/engine/ClothModel.h>
 #include <weft/engine/Material.h>
 #include <weft/engine/RenderView.h>
@@ -26,12 +27,29 @@
 
 namespace weft {
 
+struct ColliderFrame;  // internal: a collider as one step sees it
+
 /// Handle to a cloth in a World. Zero-initialised = null.
 struct ClothId {
   std::uint32_t index = 0;       ///< slot + 1 (0 = null)
   std::uint32_t generation = 0;  ///< must match the slot's generation
   bool isNull() const { return index == 0; }
   friend bool operator==(const ClothId&, const ClothId&) = default;
+};
+
+/// Handle to a collider in a World. Zero-initialised = null.
+struct ColliderId {
+  std::uint32_t index = 0;       ///< slot + 1 (0 = null)
+  std::uint32_t generation = 0;  ///< must match the slot's generation
+  bool isNull() const { return index == 0; }
+  friend bool operator==(const ColliderId&, const ColliderId&) = default;
+};
+
+/// Per-instance settings of a collider.
+struct ColliderSettings {
+  /// Coulomb friction coefficient of the collider's surface; a cloth–collider pair uses the
+  /// geometric mean of this and ClothMaterial::friction.
+  Real friction = 0.3;
 };
 
 /// Per-instance settings of a cloth.
@@ -43,6 +61,28 @@ struct ClothSettings {
   Vec3 translation{0, 0, 0};      ///< m, applied to the model's rest positions (after rotation)
   Mat3 rotation = Mat3::Identity();  ///< rotation applied to the model's rest positions
   std::vector<Index> pinnedVertices;  ///< vertices held at targets (World::setPinTargets)
+  /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
+  /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
+  bool selfCollision = true;
+};
+
+/// A snapshot of a World: time, every cloth's positions, velocities, pin targets and solver warm
+/// start, and every collider's motion. World::restoreState() brings a world back to it, after
+/// which the world continues bit for bit as it did from the save (replays, networking,
+/// rollback). Opaque: compare states through World::stateHash().
+class WorldState {
+ public:
+  WorldState();
+  ~WorldState();
+  WorldState(const WorldState&);
+  WorldState& operator=(const WorldState&);
+  WorldState(WorldState&&) noexcept;
+  WorldState& operator=(WorldState&&) noexcept;
+
+ private:
+  friend class World;
+  struct Data;
+  std::unique_ptr<Data> m_data;
 };
 
 /// World-wide settings.
@@ -73,6 +113,18 @@ class World {
   /// Sets where the pinned vertices are at the end of the next frame (one target per entry of
   /// ClothSettings::pinnedVertices, same order). Pins move linearly across the frame.
   Status setPinTargets(ClothId cloth, std::span<const Vec3> targets);
+  /// Adds a kinematic collider (plane, sphere, capsule, box or triangle mesh; see
+  /// weft/collision). Its motion (pose and velocities) is the shape's own; it moves with those
+  /// velocities during each step until setColliderMotion() changes them.
+  Result<ColliderId> addCollider(const Shape& shape, const ColliderSettings& settings = {});
+  /// Removes a collider; its handle becomes stale.
+  Status destroyCollider(ColliderId collider);
+  /// Sets the collider's pose now and its linear (m/s) and angular (rad/s) velocity for the
+  /// following steps. Validated; on error nothing changes.
+  Status setColliderMotion(ColliderId collider, const RigidMotion& motion);
+  /// The collider's shape, posed where it is now; valid until the next step or destroy.
+  Result<const Shape*> collider(ColliderId collider) const;
+
   /// Replaces a cloth's positions (m) and velocities (m/s), e.g. to start from a draped shape or
   /// to teleport it. Pinned vertices jump with it and their targets are set to the new positions.
   /// Sizes must match the vertex count and every value must be finite; on error nothing changes.
@@ -98,6 +150,12 @@ class World {
   /// stability estimate for explicit integrators).
   Result<Index> plannedSubsteps(ClothId cloth, Real frameDt) const;
 
+  /// Copies everything that decides how the world continues (see WorldState).
+  WorldState saveState() const;
+  /// Brings the world back to a saved state. The cloths and colliders of the save must still
+  /// exist (same handles); otherwise an error names the first missing one and nothing changes.
+  Status restoreState(const WorldState& state);
+
   /// 64-bit FNV-1a hash of every cloth's positions and velocities, bit for bit: equal hashes
   /// mean (almost surely) bitwise-identical states.
   std::uint64_t stateHash() const;
@@ -109,13 +167,19 @@ class World {
 
  private:
   struct ClothSlot;
+  struct ColliderSlot;
   const ClothSlot* find(ClothId cloth) const;
   ClothSlot* find(ClothId cloth);
+  const ColliderSlot* find(ColliderId collider) const;
+  ColliderSlot* find(ColliderId collider);
 
   WorldSettings m_settings;
   std::unique_ptr<TaskSystem> m_ownedTasks;  // when the caller gave none
   TaskSystem* m_tasks = nullptr;
   std::vector<std::unique_ptr<ClothSlot>> m_slots;
+  std::vector<std::unique_ptr<ColliderSlot>> m_colliderSlots;
+  std::vector<ColliderFrame> m_colliderFrames;  // scratch for step()
+  std::vector<RigidMotion> m_colliderStartMotions;  // scratch for step()
   StepStats m_stats;
   Real m_time = 0;
 };

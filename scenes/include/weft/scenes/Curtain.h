@@ -2,7 +2,8 @@
 //
 // A 2.0 m × 1.5 m cotton curtain in the z = 0 plane (x from −1 to +1, y from 0.5 to 2.0), its
 // top row pinned to a rod. Script over 10 s at 60 frames/s:
-//   0–1 s settle · 1–3 s a sphere pushes in and withdraws (collision issue; not yet simulated) ·
+//   0–1 s settle · 1–2 s a sphere (r = 0.25 m, at x = 0.3, y = 1.1) pushes into the curtain
+//   from z = −0.5 to z = +0.3, 2–3 s it withdraws ·
 //   4–6 s the rod pins slide toward the left end until the curtain is gathered to 30 % of its
 //   width · 6–8 s hold · 8–10 s open again.
 // The cloth starts with gentle pleats of ±5 mm out of the plane (CurtainSettings::initialWaviness)
@@ -27,6 +28,8 @@ struct CurtainSettings {
   /// at the rod). A real curtain never hangs perfectly flat, and a perfectly planar one has no
   /// way to choose a side when the rod gathers it: it can only crumple in its own plane.
   Real initialWaviness = 0.005;
+  bool sphere = true;        ///< the pushing sphere (and the floor far below) as colliders
+  bool selfCollision = true; ///< keep the curtain from passing through itself
   int threadCount = 0;                ///< threads of the scene's world (0 = all cores, 1 = serial)
   TaskSystem* taskSystem = nullptr;   ///< or the caller's task system (overrides threadCount)
 };
@@ -47,10 +50,19 @@ class CurtainScene {
   World& world() { return *m_world; }
   const World& world() const { return *m_world; }
   ClothId cloth() const { return m_cloth; }
+  /// The pushing sphere (null handle when CurtainSettings::sphere is false).
+  ColliderId sphere() const { return m_sphere; }
+  /// The floor plane at y = 0 (null handle when CurtainSettings::sphere is false).
+  ColliderId floor() const { return m_floor; }
+  static constexpr Real kSphereRadius = 0.25;  ///< m
+  /// Where the script puts the sphere's centre at time t (s).
+  static Vec3 spherePosition(Real t);
   const ClothModel& model() const { return *m_model; }
   std::shared_ptr<const ClothModel> sharedModel() const { return m_model; }
   /// Frames stepped so far.
   Index frame() const { return m_frame; }
+  /// Sets the script's frame counter (after World::restoreState() to a save taken at `frame`).
+  void rewindTo(Index frame) { m_frame = frame; }
 
   /// Grid vertices along the width and height for a size (41 × 31 for size 1).
   static std::array<Index, 2> gridSize(Index size);
@@ -63,6 +75,7 @@ class CurtainScene {
   std::unique_ptr<World> m_world;
   std::shared_ptr<const ClothModel> m_model;
   ClothId m_cloth;
+  ColliderId m_sphere, m_floor;
   Vec3Array m_pinRest;          // rest positions of the pinned vertices
   Vec3Array m_targets;          // scratch: this frame's targets
   bool m_pinScript = true;

@@ -1,0 +1,72 @@
+// ColliderResponse: cloth against kinematic colliders (plane, sphere, capsule, box, mesh).
+//
+// Two mechanisms, each where it is the better tool:
+//
+//  1. Before an implicit step, constraints in the solve (Baraff & Witkin 1998, §5.3): a free vertex
+//     whose predicted position x + h v lies within the contact thickness of a collider (at the
+//     collider's pose at the end of the step) is constrained along the contact normal n so that
+//     the step ends exactly at the thickness: n·Δv = (thickness − d(x + h v)) / h. The solver then
+//     carries the contact force through the cloth in the same solve, so resting contact does not
+//     jitter and a sphere pushing into a curtain moves the whole curtain.
+//  2. After every step of every integrator, a velocity-level pass in the manner of Bridson,
+//     Fedkiw & Anderson 2002: a continuous test of each vertex's motion relative to each collider
+//     (sphere tracing along the segment in the collider's frame, exact for the distance functions
+//     the shapes return) catches vertices a fast collider would otherwise pass through; any vertex
+//     within the thickness or inside is put on the surface plus thickness, its relative normal
+//     velocity is made non-negative (inelastic), and Coulomb friction removes relative tangential
+//     velocity in proportion to the normal velocity change: |Δv_t| ≤ μ |Δv_n|.
+//
+// So a vertex never ends a step inside a collider, whatever the integrator. Rotation of a collider
+// within one step is followed through its pose at both ends of the step (the vertex's start point
+// is carried with the body), translation is linear in between.
+#pragma once
+
+#include "solver/VertexFilter.h"
+
+#include <weft/Math.h>
+#include <weft/collision/Shape.h>
+
+#include <span>
+#include <vector>
+
+namespace weft {
+
+/// One collider as a cloth sees it during a step.
+struct ColliderFrame {
+  Shape* shape = nullptr;        ///< posed at the END of the step (see setPoses)
+  RigidMotion start;             ///< motion at the start of the step
+  RigidMotion end;               ///< motion at the end of the step
+  Real friction = 0.3;           ///< Coulomb coefficient against this cloth
+};
+
+/// Where a collider's motion puts it `dt` seconds later (constant linear and angular velocity).
+RigidMotion advanceMotion(const RigidMotion& motion, Real dt);
+
+/// Statistics of one response pass.
+struct ColliderResponseReport {
+  Index constrainedVertices = 0;  ///< vertices constrained in the solve
+  Index contacts = 0;             ///< vertices in contact after the step
+  Index sweptHits = 0;            ///< contacts found only by the continuous test
+};
+
+class ColliderResponse {
+ public:
+  /// Constrains vertices predicted to end within `thickness` of a collider (implicit solve).
+  /// `pinned[i]` vertices are left alone. Returns the number constrained; their indices are kept
+  /// so that the next call frees them first.
+  Index constrain(std::span<const ColliderFrame> colliders, const Vec3Array& x, const Vec3Array& v,
+                  Real h, Real thickness, const std::vector<char>& pinned, VertexFilter& filter);
+  /// Frees the constraints constrain() set.
+  void release(VertexFilter& filter);
+
+  /// After a step from xStart to (x, v): continuous test, projection, inelastic normal velocity
+  /// and friction. `vStart` is the velocity before the step (for the normal velocity change).
+  ColliderResponseReport resolve(std::span<const ColliderFrame> colliders, const Vec3Array& xStart,
+                                 const Vec3Array& vStart, Real thickness,
+                                 const std::vector<char>& pinned, Vec3Array& x, Vec3Array& v) const;
+
+ private:
+  std::vector<Index> m_constrained;
+};
+
+}  // namespace weft
