@@ -141,7 +141,7 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   m_inverseMasses.resize(n);
   const std::vector<Real>& mass = m_forces.masses();
   for (Index i = 0; i < n; ++i) m_inverseMasses[i] = m_pinnedMask[i] ? 0 : 1 / mass[i];
-  if (settings.selfCollision) m_selfCollision = std::make_unique<SelfCollision>(*m_model);
+  if (settings.selfCollision) m_selfCollision = std::make_unique<SelfCollision>(*m_model, tasks);
   estimateStiffestMode();
 }
 

@@ -34,7 +34,20 @@ Index findRoot(std::vector<Index>& parent, Index vertex) {
 
 }  // namespace
 
-SelfCollision::SelfCollision(const ClothModel& model) : m_rest(model.restPositions()) {
+void SelfCollision::refitAndQuery(const Vec3Array& from, const Vec3Array& to, Real inflate) {
+  m_bvh.refit(from, to, inflate, m_tasks);
+  if (m_tasks && m_workerPairs) {
+    m_bvh.querySelf(m_trianglePairs, *m_tasks, *m_workerPairs);
+  } else {
+    m_bvh.querySelf(m_trianglePairs);
+  }
+}
+
+SelfCollision::SelfCollision(const ClothModel& model, TaskSystem* tasks)
+    : m_rest(model.restPositions()), m_tasks(tasks) {
+  if (m_tasks) {
+    m_workerPairs = std::make_unique<PerWorker<std::vector<TrianglePair>>>(*m_tasks);
+  }
   m_bvh = Bvh::build(model.indices(), model.restPositions()).value();
   std::unordered_map<std::uint64_t, Index> edgeOfKey;
   for (Index e = 0; e < model.edges().size(); ++e) {
@@ -130,8 +143,7 @@ bool SelfCollision::findImpacts(const Vec3Array& start, Real h, Real separation)
   m_contacts.clear();
   for (std::size_t i = 0; i < start.size(); ++i) m_end[i] = start[i] + h * m_velocity[i];
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
-  m_bvh.refit(start, m_end, 2 * kDefaultContactTolerance);
-  m_bvh.querySelf(m_trianglePairs);
+  refitAndQuery(start, m_end, 2 * kDefaultContactTolerance);
   collectFeaturePairs(start, m_end, 2 * kDefaultContactTolerance);
   for (const auto& [vertex, triangle] : m_vertexTriangle) {
     const std::array<Index, 3>& corners = m_bvh.triangle(triangle);
@@ -237,8 +249,7 @@ SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real 
   // 1. Proximity at the step start: repulsion, inelastic contact and friction.
   {
     WEFT_PROFILE_ZONE("narrow phase");
-    m_bvh.refit(start, thickness);
-    m_bvh.querySelf(m_trianglePairs);
+    refitAndQuery(start, start, thickness);
     collectFeaturePairs(start, start, thickness);
   }
   {

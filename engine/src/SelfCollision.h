@@ -24,8 +24,11 @@
 #include <weft/Math.h>
 #include <weft/collision/Bvh.h>
 #include <weft/engine/ClothModel.h>
+#include <weft/threading/PerWorker.h>
+#include <weft/threading/TaskSystem.h>
 
 #include <array>
+#include <memory>
 #include <vector>
 
 namespace weft {
@@ -40,8 +43,9 @@ struct SelfCollisionReport {
 
 class SelfCollision {
  public:
-  /// Builds the BVH and the edge tables of the model.
-  explicit SelfCollision(const ClothModel& model);
+  /// Builds the BVH and the edge tables of the model. BVH refits and queries run on `tasks`
+  /// (null: serial), with the same results either way.
+  explicit SelfCollision(const ClothModel& model, TaskSystem* tasks = nullptr);
 
   /// Adjusts the step x₀ → x₁ (positions) and v (velocities, set to the average velocity of the
   /// corrected step) so that the cloth neither ends closer than `thickness` to itself where it
@@ -67,9 +71,12 @@ class SelfCollision {
   void applyImpulse(const Contact& contact, Real targetNormalSpeed, Real friction,
                     const std::vector<Real>& inverseMasses);
   void rigidifyZones(const Vec3Array& start, const std::vector<Real>& inverseMasses);
+  void refitAndQuery(const Vec3Array& from, const Vec3Array& to, Real inflate);
 
   Vec3Array m_rest;  // rest positions: features closer than the thickness at rest never repel
   Bvh m_bvh;
+  TaskSystem* m_tasks = nullptr;
+  std::unique_ptr<PerWorker<std::vector<TrianglePair>>> m_workerPairs;  // with m_tasks
   std::vector<std::array<Index, 3>> m_triangleEdges;  // edge ids of each triangle
   std::vector<std::array<Index, 2>> m_edges;          // vertex ids of each edge
   Vec3Array m_velocity;                               // v̄ being corrected
