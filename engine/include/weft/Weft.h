@@ -1,6 +1,6 @@
 // Weft.h: the whole public engine API in one include, for code that embeds the engine.
 //
-//   #include <weft/Weft.h>   // World, ClothModel, materials, solver settings, stats, render views
+//   #include <weft/Weft.h>   // World, ClothModel, materials, presets, settings, stats, views
 //
 // Only the engine's public headers (and, through them, weft/Math.h, weft/Result.h and the
 // TaskSystem a World can share). Not weft::render: drawing stays outside the engine, and a game
@@ -8,6 +8,7 @@
 #pragma once
 
 #include <weft/engine/ClothModel.h>
+#include <weft/engine/FabricPresets.h>
 #include <weft/engine/Material.h>
 #include <weft/engine/RenderView.h>
 #include <weft/engine/SolverSettings.h>
