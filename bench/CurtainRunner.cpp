@@ -307,6 +307,7 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   }
 #if WEFT_HAVE_RENDER
   if (pipeline) {
+    WEFT_PROFILE_ZONE("capture");
     for (const auto& [frame, image] : pipeline->captured()) {
       char name[32];
       std::snprintf(name, sizeof name, "frame_%04u.png", frame);

@@ -1,5 +1,7 @@
 #include "Cloth.h"
 
+#include <weft/threading/Profiler.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -309,6 +311,7 @@ bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<Collider
     report.integrator.solveMs += substepReport.solveMs;
     // A cheap health check each substep: a NaN spreads through the whole mesh within one solve,
     // and a diverging explicit method passes any physical speed within a few substeps.
+    WEFT_PROFILE_ZONE("health");
     bool healthy = true;
     for (const Vec3& x : m_positions) healthy = healthy && x.allFinite();
     for (const Vec3& v : m_velocities) {

@@ -1,5 +1,7 @@
 #include "ColliderResponse.h"
 
+#include <weft/threading/Profiler.h>
+
 #include <algorithm>
 #include <cmath>
 
@@ -21,6 +23,7 @@ Index ColliderResponse::constrain(std::span<const ColliderFrame> colliders, cons
                                   const std::vector<char>& pinned, VertexFilter& filter) {
   release(filter);
   if (colliders.empty()) return 0;
+  WEFT_PROFILE_ZONE("narrow phase");
   for (Index i = 0; i < x.size(); ++i) {
     if (pinned[i]) continue;
     const Vec3 predicted = x[i] + h * v[i];
@@ -79,6 +82,7 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
   ColliderResponseReport report;
   report.constrainedVertices = Index(m_constrained.size());
   if (colliders.empty()) return report;
+  WEFT_PROFILE_ZONE("response");
   for (Index i = 0; i < x.size(); ++i) {
     if (pinned[i]) continue;
     bool touched = false;

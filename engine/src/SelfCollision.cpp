@@ -35,6 +35,7 @@ Index findRoot(std::vector<Index>& parent, Index vertex) {
 }  // namespace
 
 void SelfCollision::refitAndQuery(const Vec3Array& from, const Vec3Array& to, Real inflate) {
+  WEFT_PROFILE_ZONE("broad phase");
   m_bvh.refit(from, to, inflate, m_tasks);
   if (m_tasks && m_workerPairs) {
     m_bvh.querySelf(m_trianglePairs, *m_tasks, *m_workerPairs);
@@ -145,6 +146,7 @@ bool SelfCollision::findImpacts(const Vec3Array& start, Real h, Real separation)
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
   refitAndQuery(start, m_end, 2 * kDefaultContactTolerance);
   collectFeaturePairs(start, m_end, 2 * kDefaultContactTolerance);
+  WEFT_PROFILE_ZONE("narrow phase");
   for (const auto& [vertex, triangle] : m_vertexTriangle) {
     const std::array<Index, 3>& corners = m_bvh.triangle(triangle);
     const std::array<Vec3, 3> triangleStart{start[corners[0]], start[corners[1]], start[corners[2]]};
@@ -247,12 +249,10 @@ SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real 
   for (std::size_t i = 0; i < n; ++i) m_velocity[i] = (x[i] - start[i]) / h;
 
   // 1. Proximity at the step start: repulsion, inelastic contact and friction.
+  refitAndQuery(start, start, thickness);
+  collectFeaturePairs(start, start, thickness);
   {
-    WEFT_PROFILE_ZONE("narrow phase");
-    refitAndQuery(start, start, thickness);
-    collectFeaturePairs(start, start, thickness);
-  }
-  {
+    // Proximity: the exact distance tests and the impulses they call for, pair by pair.
     WEFT_PROFILE_ZONE("response");
     for (const auto& [vertex, triangle] : m_vertexTriangle) {
       const std::array<Index, 3>& c = m_bvh.triangle(triangle);
@@ -305,6 +305,7 @@ SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real 
   for (int pass = 0; pass < kImpulsePasses; ++pass) {
     colliding = findImpacts(start, h, separationSpeed);
     if (!colliding) break;
+    WEFT_PROFILE_ZONE("response");
     for (const Contact& contact : m_contacts) {
       applyImpulse(contact, separationSpeed, friction, inverseMasses);
       ++report.impacts;
