@@ -39,6 +39,13 @@ void SelfCollision::refitAndQuery(const Vec3Array& from, const Vec3Array& to, Re
   m_bvh.refit(from, to, inflate, m_tasks);
   if (m_tasks && m_workerPairs) {
     m_bvh.querySelf(m_trianglePairs, *m_tasks, *m_workerPairs);
+    // Which worker finds which pairs depends on scheduling, so a worker's list may need any
+    // share of the total: give each room for all of it, so that allocation follows the number
+    // of pairs (which grows only with contact) and never the timing of the threads.
+    const std::size_t total = m_trianglePairs.size();
+    m_workerPairs->forEach([total](std::vector<TrianglePair>& pairs) {
+      if (pairs.capacity() < total) pairs.reserve(total);
+    });
   } else {
     m_bvh.querySelf(m_trianglePairs);
   }
