@@ -295,12 +295,9 @@ std::vector<SweepConfig> sweepConfigs(const ErrorTimeOptions& options) {
       }
     }
   }
-  const std::pair<const char*, IntegratorKind> explicitMethods[] = {
-      {"explicit-euler", IntegratorKind::ExplicitEuler},
-      {"symplectic-euler", IntegratorKind::SymplecticEuler},
-      {"midpoint", IntegratorKind::Midpoint},
-      {"rk4", IntegratorKind::RungeKutta4}};
-  for (const auto& [method, kind] : explicitMethods) {
+  for (IntegratorKind kind : {IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler,
+                              IntegratorKind::Midpoint, IntegratorKind::RungeKutta4}) {
+    const char* method = integratorName(kind);
     for (Index n : explicitSubsteps) {
       SweepConfig config{method, SolverSettings{}, false};
       config.solver.integrator = kind;

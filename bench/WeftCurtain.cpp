@@ -31,12 +31,14 @@ int main(int argc, char** argv) {
   app.add_option("--csv", options.frameCsv, "Write per-frame statistics here (CSV)");
   app.add_option("--trace", options.trace,
                  "Record profiler zones and write a Chrome trace here (open in Perfetto)");
-  const std::map<std::string, weft::IntegratorKind> integrators{
-      {"implicit-euler", weft::IntegratorKind::ImplicitEuler},
-      {"explicit-euler", weft::IntegratorKind::ExplicitEuler},
-      {"symplectic-euler", weft::IntegratorKind::SymplecticEuler},
-      {"midpoint", weft::IntegratorKind::Midpoint},
-      {"rk4", weft::IntegratorKind::RungeKutta4}};
+  // Names come from the engine (integratorName), so the flag and the reports cannot disagree.
+  std::map<std::string, weft::IntegratorKind> integrators;
+  for (weft::IntegratorKind kind :
+       {weft::IntegratorKind::ImplicitEuler, weft::IntegratorKind::ExplicitEuler,
+        weft::IntegratorKind::SymplecticEuler, weft::IntegratorKind::Midpoint,
+        weft::IntegratorKind::RungeKutta4}) {
+    integrators.emplace(weft::integratorName(kind), kind);
+  }
   app.add_option("--integrator", options.integrator, "Time integrator")
       ->transform(CLI::CheckedTransformer(integrators, CLI::ignore_case));
   std::string overlap = "on";

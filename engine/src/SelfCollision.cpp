@@ -147,7 +147,7 @@ void SelfCollision::applyImpulse(const Contact& contact, Real targetNormalSpeed,
   }
 }
 
-bool SelfCollision::findImpacts(const Vec3Array& start, Real h, Real separation) {
+bool SelfCollision::findImpacts(const Vec3Array& start, Real h) {
   m_contacts.clear();
   for (std::size_t i = 0; i < start.size(); ++i) m_end[i] = start[i] + h * m_velocity[i];
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
@@ -192,7 +192,6 @@ bool SelfCollision::findImpacts(const Vec3Array& start, Real h, Real separation)
     if (normal.dot(startGap) < 0) normal = -normal;
     m_contacts.push_back({{p[0], p[1], q[0], q[1]}, {1 - s, s, -(1 - u), -u}, normal, 0});
   }
-  (void)separation;
   return !m_contacts.empty();
 }
 
@@ -310,7 +309,7 @@ SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real 
   const Real separationSpeed = kImpactSeparation * thickness / h;
   bool colliding = false;
   for (int pass = 0; pass < kImpulsePasses; ++pass) {
-    colliding = findImpacts(start, h, separationSpeed);
+    colliding = findImpacts(start, h);
     if (!colliding) break;
     WEFT_PROFILE_ZONE("response");
     for (const Contact& contact : m_contacts) {
@@ -331,7 +330,7 @@ SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real 
       }
       rigidifyZones(start, inverseMasses);
       ++report.impactZones;
-      colliding = findImpacts(start, h, separationSpeed);
+      colliding = findImpacts(start, h);
     }
     // Vertices that start free of crossings and do not move cannot cross: hold the rest.
     while (colliding) {
@@ -347,7 +346,7 @@ SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real 
       // Nothing left to hold still: the pairs are between pinned vertices, which move as
       // scripted; the caller's pins are beyond what the cloth can answer for.
       if (report.frozenVertices == frozenBefore) break;
-      colliding = findImpacts(start, h, separationSpeed);
+      colliding = findImpacts(start, h);
     }
   }
 

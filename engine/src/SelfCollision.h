@@ -67,7 +67,7 @@ class SelfCollision {
   // Vertex–triangle and edge–edge pairs of the candidate triangle pairs whose own boxes (over
   // positions `from` and `to`, one side inflated by `margin`) overlap; sorted and unique.
   void collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin);
-  bool findImpacts(const Vec3Array& start, Real h, Real separation);
+  bool findImpacts(const Vec3Array& start, Real h);
   void applyImpulse(const Contact& contact, Real targetNormalSpeed, Real friction,
                     const std::vector<Real>& inverseMasses);
   void rigidifyZones(const Vec3Array& start, const std::vector<Real>& inverseMasses);

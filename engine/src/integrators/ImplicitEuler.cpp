@@ -63,7 +63,7 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   // Pins: the velocity change that puts each pinned vertex exactly on its target at t + h.
   for (Index vertex : m_filteredVertices) m_filter.setFree(vertex);
   m_filteredVertices.assign(system.prescribedVertices().begin(), system.prescribedVertices().end());
-  m_prescribedPosition = x;
+  // applyPrescribedMotion writes every prescribed entry, and only those are read below.
   system.applyPrescribedMotion(t + h, m_prescribedPosition, m_prescribedVelocity);
   for (Index vertex : m_filteredVertices) {
     m_filter.setFixed(vertex, (m_prescribedPosition[vertex] - x[vertex]) / h - v[vertex]);
