@@ -242,6 +242,22 @@ Status Cloth::setPinTargets(std::span<const Vec3> targets) {
   return Status::success();
 }
 
+Status Cloth::setExternalForces(std::span<const Vec3> forces) {
+  if (!forces.empty() && forces.size() != m_positions.size()) {
+    return Error{"setExternalForces: got " + std::to_string(forces.size()) +
+                 " forces for a cloth of " + std::to_string(m_positions.size()) +
+                 " vertices; give one per vertex, or none to remove them"};
+  }
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    if (!forces[i].allFinite()) {
+      return Error{"setExternalForces: the force on vertex " + std::to_string(i) +
+                   " is NaN or infinite"};
+    }
+  }
+  m_forces.setExternalForces(forces);
+  return Status::success();
+}
+
 Status Cloth::setState(std::span<const Vec3> positions, std::span<const Vec3> velocities) {
   const std::size_t n = m_positions.size();
   if (positions.size() != n || velocities.size() != n) {

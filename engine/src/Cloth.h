@@ -55,6 +55,10 @@ class Cloth final : public DynamicSystem {
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
 
   Status setPinTargets(std::span<const Vec3> targets);
+  /// N per vertex, added to every evaluation until changed; an empty span removes them.
+  Status setExternalForces(std::span<const Vec3> forces);
+  /// m/s, air velocity for the drag force (validated by the World).
+  void setWind(const Vec3& wind) { m_forces.setWind(wind); }
   const Vec3Array& pinTargets() const { return m_pinEnd; }
 
   const Vec3Array& positions() const { return m_positions; }

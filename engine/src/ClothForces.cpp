@@ -185,7 +185,7 @@ Real ClothForces::evaluate(const Pass& pass) const {
   TaskSystem& tasks = m_tasks ? *m_tasks : *m_serialTasks;
   const auto sum = [](Real a, Real b) { return a + b; };
 
-  // Per-vertex terms: gravity and linear air drag; the mass matrix and drag on the diagonal.
+  // Per-vertex terms: gravity, linear air drag and external forces; the mass matrix and drag on the diagonal.
   Real energy = tasks.parallelReduce(
       Index(m_masses.size()), kGrainVertices, Real(0),
       [&](Index begin, Index end) {
@@ -195,6 +195,11 @@ Real ClothForces::evaluate(const Pass& pass) const {
           pass.f[i] =
               m_masses[i] * m_settings.gravity - dragCoefficient * (pass.v[i] - m_settings.wind);
           blockEnergy -= m_masses[i] * m_settings.gravity.dot(x[i]);
+          if (!m_externalForces.empty()) {
+            // A constant force is the gradient of the potential −f·x.
+            pass.f[i] += m_externalForces[i];
+            blockEnergy -= m_externalForces[i].dot(x[i]);
+          }
           if (jacobians) {
             pass.matrix->block(m_diagonalSlots[i]) =
                 (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();

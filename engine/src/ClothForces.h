@@ -28,6 +28,7 @@
 
 #include <array>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -69,6 +70,14 @@ class ClothForces {
     return {m_triangleColours.size() - 1, m_hingeColours.size() - 1, m_springColours.size() - 1};
   }
   const ClothForceSettings& settings() const { return m_settings; }
+  /// m/s, air velocity felt through the drag from the next evaluation on.
+  void setWind(const Vec3& wind) { m_settings.wind = wind; }
+  /// N, a force on every vertex added to each evaluation (constant in x and v, so no Jacobian);
+  /// empty: none. Sizes and finiteness are checked by the caller.
+  void setExternalForces(std::span<const Vec3> forces) {
+    m_externalForces.assign(forces.begin(), forces.end());
+  }
+  const Vec3Array& externalForces() const { return m_externalForces; }
 
  private:
   struct Pass;  // one evaluation: what to compute and where to put it
@@ -95,6 +104,7 @@ class ClothForces {
   // Elements are stored sorted by colour; colour k holds [colours[k], colours[k + 1]).
   std::vector<Index> m_triangleColours, m_hingeColours, m_springColours;
   std::vector<Index> m_diagonalSlots;
+  Vec3Array m_externalForces;  // N per vertex, or empty
   TaskSystem* m_tasks = nullptr;
   std::unique_ptr<TaskSystem> m_serialTasks;  // used when m_tasks is null; reused, so no allocation
   bool m_bending = false;  // bending stiffness or damping non-zero

@@ -4,6 +4,7 @@
 
 #include <weft/threading/Profiler.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -27,9 +28,17 @@ std::string describe(StepStatus status) {
   return text;
 }
 
+/// A pinned vertex whose target follows a collider.
+struct ColliderAttachment {
+  Index pinSlot = 0;     // index into ClothSettings::pinnedVertices
+  ColliderId collider;
+  Vec3 localOffset = Vec3::Zero();  // m, the vertex in the collider's body frame
+};
+
 struct World::ClothSlot {
   std::unique_ptr<Cloth> cloth;  // null when free
   std::uint32_t generation = 1;
+  std::vector<ColliderAttachment> attachments;  // sorted by pinSlot
 };
 
 struct World::ColliderSlot {
@@ -145,6 +154,10 @@ Error staleCollider(const char* operation, ColliderId id) {
 Status World::destroyCollider(ColliderId id) {
   ColliderSlot* slot = find(id);
   if (!slot) return staleCollider("destroyCollider", id);
+  for (const std::unique_ptr<ClothSlot>& cloth : m_slots) {
+    std::erase_if(cloth->attachments,
+                  [&](const ColliderAttachment& attachment) { return attachment.collider == id; });
+  }
   slot->shape.reset();
   ++slot->generation;
   return Status::success();
@@ -166,6 +179,7 @@ Status World::destroyCloth(ClothId id) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("destroyCloth", id);
   slot->cloth.reset();
+  slot->attachments.clear();
   ++slot->generation;  // every copy of the old handle is now stale
   return Status::success();
 }
@@ -174,6 +188,92 @@ Status World::setPinTargets(ClothId id, std::span<const Vec3> targets) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("setPinTargets", id);
   return slot->cloth->setPinTargets(targets);
+}
+
+namespace {
+// Where each vertex sits in ClothSettings::pinnedVertices, or an error naming the first vertex
+// that is not pinned.
+Result<std::vector<Index>> pinSlotsOf(const char* operation, const ClothSettings& settings,
+                                      Index vertexCount, std::span<const Index> vertices) {
+  std::vector<Index> slots;
+  slots.reserve(vertices.size());
+  for (Index vertex : vertices) {
+    if (vertex >= vertexCount) {
+      return Error{std::string(operation) + ": vertex " + std::to_string(vertex) +
+                   " is out of range; the cloth has " + std::to_string(vertexCount) + " vertices"};
+    }
+    const auto& pins = settings.pinnedVertices;
+    const auto found = std::find(pins.begin(), pins.end(), vertex);
+    if (found == pins.end()) {
+      return Error{std::string(operation) + ": vertex " + std::to_string(vertex) +
+                   " is not pinned; list it in ClothSettings::pinnedVertices to attach it"};
+    }
+    slots.push_back(Index(found - pins.begin()));
+  }
+  return slots;
+}
+}  // namespace
+
+Status World::attachToCollider(ClothId id, std::span<const Index> vertices,
+                               ColliderId colliderId) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("attachToCollider", id);
+  const ColliderSlot* collider = find(colliderId);
+  if (!collider) return staleCollider("attachToCollider", colliderId);
+  Result<std::vector<Index>> slots = pinSlotsOf("attachToCollider", slot->cloth->settings(),
+                                                slot->cloth->vertexCount(), vertices);
+  if (!slots.ok()) return slots.error();
+  const Pose& pose = motion(*collider->shape).pose;
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    const Index pinSlot = slots.value()[k];
+    std::erase_if(slot->attachments,
+                  [&](const ColliderAttachment& a) { return a.pinSlot == pinSlot; });
+    // The offset from where the pin is headed, so a pin mid-way along a scripted path is caught
+    // where the caller last put it.
+    const Vec3 target = slot->cloth->pinTargets()[pinSlot];
+    slot->attachments.push_back(ColliderAttachment{pinSlot, colliderId, pose.toLocal(target)});
+  }
+  std::sort(slot->attachments.begin(), slot->attachments.end(),
+            [](const ColliderAttachment& a, const ColliderAttachment& b) {
+              return a.pinSlot < b.pinSlot;
+            });
+  return Status::success();
+}
+
+Status World::detachFromCollider(ClothId id, std::span<const Index> vertices) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("detachFromCollider", id);
+  Result<std::vector<Index>> slots = pinSlotsOf("detachFromCollider", slot->cloth->settings(),
+                                                slot->cloth->vertexCount(), vertices);
+  if (!slots.ok()) return slots.error();
+  for (Index pinSlot : slots.value()) {
+    std::erase_if(slot->attachments,
+                  [&](const ColliderAttachment& a) { return a.pinSlot == pinSlot; });
+  }
+  return Status::success();
+}
+
+Result<Index> World::attachedVertexCount(ClothId id) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("attachedVertexCount", id);
+  return Index(slot->attachments.size());
+}
+
+Status World::setExternalForces(ClothId id, std::span<const Vec3> forces) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("setExternalForces", id);
+  return slot->cloth->setExternalForces(forces);
+}
+
+Status World::setWind(const Vec3& wind) {
+  if (!wind.allFinite()) {
+    return Error{"setWind: the wind velocity is NaN or infinite; give it in m/s"};
+  }
+  m_settings.wind = wind;
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (slot->cloth) slot->cloth->setWind(wind);
+  }
+  return Status::success();
 }
 
 Status World::setState(ClothId id, std::span<const Vec3> positions,
@@ -187,6 +287,23 @@ Result<std::vector<Vec3>> World::pinTargets(ClothId id) const {
   const ClothSlot* slot = find(id);
   if (!slot) return staleHandle("pinTargets", id);
   return std::vector<Vec3>(slot->cloth->pinTargets().begin(), slot->cloth->pinTargets().end());
+}
+
+void World::updateAttachedPins(Real frameDt) {
+  // Attached pins end the frame where their collider's pose, advanced by its velocities, puts
+  // them; across the frame they move linearly like every pin (the chord of a turning collider's
+  // arc, which one frame keeps short).
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (!slot->cloth || slot->attachments.empty()) continue;
+    const Vec3Array& targets = slot->cloth->pinTargets();
+    m_attachedTargets.assign(targets.begin(), targets.end());
+    for (const ColliderAttachment& attachment : slot->attachments) {
+      const ColliderSlot* collider = find(attachment.collider);
+      const Pose end = advanceMotion(motion(*collider->shape), frameDt).pose;
+      m_attachedTargets[attachment.pinSlot] = end.toWorld(attachment.localOffset);
+    }
+    (void)slot->cloth->setPinTargets(m_attachedTargets);
+  }
 }
 
 StepStatus World::step(Real frameDt) {
@@ -205,6 +322,7 @@ StepStatus World::step(Real frameDt) {
   for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
     if (collider->shape) m_colliderStartMotions.push_back(motion(*collider->shape));
   }
+  updateAttachedPins(frameDt);
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
     if (!slot->cloth) continue;
     Cloth& cloth = *slot->cloth;

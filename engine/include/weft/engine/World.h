@@ -125,6 +125,29 @@ class World {
   /// The collider's shape, posed where it is now; valid until the next step or destroy.
   Result<const Shape*> collider(ColliderId collider) const;
 
+  /// Ties pinned vertices of a cloth to a collider, rigidly, at the offsets they have from it
+  /// now: from the next step on, their targets follow the collider's pose (a cape on a moving
+  /// shoulder, a flag on a turning pole) and setPinTargets() no longer moves them. Each vertex
+  /// must be listed in ClothSettings::pinnedVertices; attaching one again moves it to the new
+  /// collider. Destroying the collider detaches its vertices, which then stay where they are.
+  /// Validated; on error nothing changes.
+  Status attachToCollider(ClothId cloth, std::span<const Index> vertices, ColliderId collider);
+  /// Frees attached vertices from their colliders; they stay pinned where they are. Vertices
+  /// that are not attached are ignored.
+  Status detachFromCollider(ClothId cloth, std::span<const Index> vertices);
+  /// Number of the cloth's vertices attached to colliders.
+  Result<Index> attachedVertexCount(ClothId cloth) const;
+
+  /// N, a force on each vertex of the cloth (one per vertex, in vertex order), applied every
+  /// substep until changed; an empty span removes them. Pinned vertices ignore it. Game forces
+  /// such as a blast, a hand pulling or a scripted gust go here. On error nothing changes.
+  Status setExternalForces(ClothId cloth, std::span<const Vec3> forces);
+  /// m/s, the air velocity every cloth feels through ClothMaterial::airDrag from the next step
+  /// on (WorldSettings::wind at creation). Must be finite; on error nothing changes.
+  Status setWind(const Vec3& wind);
+  /// m/s, the current air velocity.
+  const Vec3& wind() const { return m_settings.wind; }
+
   /// Replaces a cloth's positions (m) and velocities (m/s), e.g. to start from a draped shape or
   /// to teleport it. Pinned vertices jump with it and their targets are set to the new positions.
   /// Sizes must match the vertex count and every value must be finite; on error nothing changes.
@@ -172,6 +195,7 @@ class World {
   ClothSlot* find(ClothId cloth);
   const ColliderSlot* find(ColliderId collider) const;
   ColliderSlot* find(ColliderId collider);
+  void updateAttachedPins(Real frameDt);
 
   WorldSettings m_settings;
   std::unique_ptr<TaskSystem> m_ownedTasks;  // when the caller gave none
@@ -180,6 +204,7 @@ class World {
   std::vector<std::unique_ptr<ColliderSlot>> m_colliderSlots;
   std::vector<ColliderFrame> m_colliderFrames;  // scratch for step()
   std::vector<RigidMotion> m_colliderStartMotions;  // scratch for step()
+  std::vector<Vec3> m_attachedTargets;              // scratch for step()
   StepStats m_stats;
   Real m_time = 0;
 };
