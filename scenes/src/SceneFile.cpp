@@ -229,7 +229,14 @@ class Reader {
     readVec3(*value, here, "axis", axis, "", true);
     readReal(*value, here, "angleDegrees", degrees, Range::Any, "degrees");
     if (issueCount() != before) return false;
-    out = Quat(Eigen::AngleAxis<Real>(degrees * kPi / 180, axis.normalized()));
+    const Real radians = degrees * kPi / 180;
+    const Vec3 unitAxis = axis.normalized();
+    if (!std::isfinite(radians) || !unitAxis.allFinite()) {
+      fail(here, "the angle or axis is too large to turn into a rotation; give an angle in degrees "
+                 "(e.g. 90) and an axis of ordinary length");
+      return false;
+    }
+    out = Quat(Eigen::AngleAxis<Real>(radians, unitAxis));
     out.normalize();
     return true;
   }
@@ -679,7 +686,9 @@ std::optional<ColliderDescription> readCollider(Reader& reader, const Json& obje
     }
   } else if (capsule) {
     Real radius = 0, halfLength = 0;
-    const bool given = required("radius", "the radius in metres") & required("halfLength", "half the core segment's length in metres");
+    const bool hasRadius = required("radius", "the radius in metres");
+    const bool hasHalfLength = required("halfLength", "half the core segment's length in metres");
+    const bool given = hasRadius && hasHalfLength;
     if (given && reader.readReal(object, path, "radius", radius, Range::Positive, "m") &&
         reader.readReal(object, path, "halfLength", halfLength, Range::NonNegative, "m") &&
         reader.issueCount() == before) {

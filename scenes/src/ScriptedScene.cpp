@@ -155,11 +155,13 @@ void ScriptedScene::pinTargetsAt(std::size_t k, Real t, std::vector<Vec3>& targe
 
 StepStatus ScriptedScene::stepFrame() {
   const Real endTime = Real(m_frame + 1) * m_description.frameDt;
+  // A script can still produce a non-finite target (a scale of 1e300 on a far-away pin); the world
+  // refuses it, the pins hold where they are, and the frame reports InvalidInput.
+  StepStatus refused = StepStatus::Ok;
   for (std::size_t k = 0; k < m_cloths.size(); ++k) {
     if (!m_scripted[k]) continue;
     pinTargetsAt(k, endTime, m_targets);
-    // Cannot fail: one finite target per pin, on a live handle.
-    (void)m_world->setPinTargets(m_cloths[k], m_targets);
+    if (!m_world->setPinTargets(m_cloths[k], m_targets).ok()) refused = StepStatus::InvalidInput;
   }
   for (std::size_t k = 0; k < m_colliders.size(); ++k) {
     const ColliderDescription& collider = m_description.colliders[k];
@@ -176,10 +178,10 @@ StepStatus ScriptedScene::stepFrame() {
       const Eigen::AngleAxis<Real> turn(delta.normalized());
       current.angularVelocity = turn.axis() * (turn.angle() / m_description.frameDt);
     }
-    (void)m_world->setColliderMotion(m_colliders[k], current);
+    if (!m_world->setColliderMotion(m_colliders[k], current).ok()) refused = StepStatus::InvalidInput;
   }
   ++m_frame;
-  return m_world->step(m_description.frameDt);
+  return m_world->step(m_description.frameDt) | refused;
 }
 
 }  // namespace weft

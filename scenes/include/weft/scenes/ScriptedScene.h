@@ -39,7 +39,8 @@ class ScriptedScene {
   static Result<ScriptedScene> create(SceneDescription description,
                                       const ScriptedSceneSettings& settings = {});
 
-  /// Sets this frame's pin targets and collider velocities, then steps one frame.
+  /// Sets this frame's pin targets and collider velocities, then steps one frame. A target or
+  /// motion the world refuses (non-finite) is skipped and flagged StepStatus::InvalidInput.
   StepStatus stepFrame();
 
   World& world() { return *m_world; }
