@@ -188,18 +188,24 @@ int runScene(const RunOptions& options, std::ostream& out) {
       return 1;
     }
   }
-  std::vector<SelfIntersectionCounter> counters;
+  // One counter over every cloth at once (vertex indices offset per cloth), so that pairs between
+  // two cloths count as well as pairs within one.
+  std::optional<SelfIntersectionCounter> counter;
+  std::vector<Vec3> allPositions;
   if (options.checkIntersections) {
-    for (std::size_t k = 0; k < scene.clothCount(); ++k) {
-      const ClothModel& model = *scenario.cloths[k].model;
-      Result<SelfIntersectionCounter> counter = SelfIntersectionCounter::create(model.indices(), model.restPositions());
-      if (!counter.ok()) {
-        out << "weft run: " << counter.error().message << "\n";
-        return 1;
-      }
-      counters.push_back(std::move(counter).value());
+    std::vector<Index> allIndices;
+    for (const ClothDescription& cloth : scenario.cloths) {
+      const Index base = Index(allPositions.size());
+      for (Index index : cloth.model->indices()) allIndices.push_back(base + index);
+      allPositions.insert(allPositions.end(), cloth.model->restPositions().begin(), cloth.model->restPositions().end());
     }
-    out << "  checking   intersecting triangle pairs within each cloth, every frame (not timed)\n";
+    Result<SelfIntersectionCounter> created = SelfIntersectionCounter::create(allIndices, allPositions);
+    if (!created.ok()) {
+      out << "weft run: " << created.error().message << "\n";
+      return 1;
+    }
+    counter.emplace(std::move(created).value());
+    out << "  checking   intersecting triangle pairs, within and between cloths, every frame (not timed)\n";
   }
   out << std::flush;
 
@@ -235,11 +241,13 @@ int runScene(const RunOptions& options, std::ostream& out) {
       renderMs.push_back(drawn.value());
     }
 #endif
-    if (!counters.empty()) {
-      Index pairs = 0;
-      for (std::size_t k = 0; k < counters.size(); ++k) {
-        pairs += counters[k].count(scene.world().positions(scene.cloth(k)).value());
+    if (counter) {
+      allPositions.clear();
+      for (std::size_t k = 0; k < scene.clothCount(); ++k) {
+        const std::span<const Vec3> x = scene.world().positions(scene.cloth(k)).value();
+        allPositions.insert(allPositions.end(), x.begin(), x.end());
       }
+      const Index pairs = counter->count(allPositions);
       maxIntersections = std::max(maxIntersections, pairs);
       framesWithIntersections += pairs > 0;
     }
@@ -292,7 +300,7 @@ int runScene(const RunOptions& options, std::ostream& out) {
       << "  contacts       " << maxContacts << " vertices on colliders at most; " << maxSelfContacts
       << " self-contact pairs at most\n"
       << "  status         " << statuses.describe() << "\n";
-  if (!counters.empty()) {
+  if (counter) {
     out << "  intersections  " << maxIntersections << " pairs at most, in " << framesWithIntersections
         << " frame(s)\n";
   }
@@ -315,7 +323,7 @@ int runScene(const RunOptions& options, std::ostream& out) {
         {"max_contacts", maxContacts},
         {"max_self_contacts", maxSelfContacts},
         {"status", describe(seen)},
-        {"intersections", counters.empty() ? std::int64_t(-1) : std::int64_t(maxIntersections)},
+        {"intersections", counter ? std::int64_t(maxIntersections) : std::int64_t(-1)},
         {"state_hash", hex(hash)},
     };
     std::ofstream file(options.summaryJson);
