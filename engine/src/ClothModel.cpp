@@ -16,7 +16,11 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
@@ -396,17 +400,32 @@ void ClothModel::buildMeshSprings() {
 }
 
 Result<TriangleMesh> ClothModel::readObj(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  std::ostringstream text;
+  if (file) text << file.rdbuf();
+  if (!file || std::filesystem::is_directory(path)) {
+    return Error{"cannot read OBJ file '" + path + "': " +
+                 (file ? std::string("it is a directory") : std::string(std::strerror(errno))) +
+                 "; check the path, the permissions and that it is a Wavefront OBJ file"};
+  }
+  return parseObj(text.str(), "OBJ file '" + path + "'");
+}
+
+Result<TriangleMesh> ClothModel::parseObj(std::string_view text, std::string_view source) {
   tinyobj::ObjReaderConfig config;
   config.triangulate = true;  // polygons become fans
   config.vertex_color = false;
   tinyobj::ObjReader reader;
-  if (!reader.ParseFromFile(path, config)) {
+  // No material library: a cloth model takes nothing from one, and reading from memory keeps
+  // the parse free of file access (so it can be fuzzed).
+  if (!reader.ParseFromString(std::string(text), std::string(), config)) {
     std::string reason = reader.Error();
     while (!reason.empty() && (reason.back() == '\n' || reason.back() == '\r')) reason.pop_back();
-    return Error{"cannot read OBJ file '" + path + "': " +
+    return Error{"cannot read " + std::string(source) + ": " +
                  (reason.empty() ? std::string("unknown parse error") : reason) +
-                 "; check the path, the permissions and that it is a Wavefront OBJ file"};
+                 "; check that it is a Wavefront OBJ file"};
   }
+  const std::string name(source);
   const tinyobj::attrib_t& attributes = reader.GetAttrib();
   TriangleMesh mesh;
   const std::size_t vertexCount = attributes.vertices.size() / 3;
@@ -420,14 +439,14 @@ Result<TriangleMesh> ClothModel::readObj(const std::string& path) {
     for (std::size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
       const std::size_t corners = shape.mesh.num_face_vertices[face];
       if (corners != 3) {
-        return Error{"OBJ file '" + path + "', shape '" + shape.name + "', face " +
+        return Error{name + ", shape '" + shape.name + "', face " +
                      std::to_string(face) + ": has " + std::to_string(corners) +
                      " corners after triangulation; give faces of at least three vertices"};
       }
       for (std::size_t k = 0; k < 3; ++k) {
         const int index = shape.mesh.indices[offset + k].vertex_index;
         if (index < 0 || std::size_t(index) >= vertexCount) {
-          return Error{"OBJ file '" + path + "', shape '" + shape.name + "', face " +
+          return Error{name + ", shape '" + shape.name + "', face " +
                        std::to_string(face) + ": vertex index " + std::to_string(index + 1) +
                        " is out of range (the file has " + std::to_string(vertexCount) +
                        " vertices)"};
@@ -438,7 +457,7 @@ Result<TriangleMesh> ClothModel::readObj(const std::string& path) {
     }
   }
   if (mesh.indices.empty()) {
-    return Error{"OBJ file '" + path + "' has no faces; a cloth needs at least one triangle"};
+    return Error{name + " has no faces; a cloth needs at least one triangle"};
   }
   return mesh;
 }

@@ -33,6 +33,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace weft {
@@ -117,6 +118,9 @@ class ClothModel {
   static Result<ClothModel> fromMesh(const TriangleMesh& mesh, const MeshSettings& settings = {});
   /// Reads positions and triangles (polygons are fanned) from a Wavefront OBJ file.
   static Result<TriangleMesh> readObj(const std::string& path);
+  /// Parses Wavefront OBJ text held in memory, as readObj() does a file (material libraries are
+  /// not read). `source` names the text in messages, e.g. "OBJ file 'cape.obj'".
+  static Result<TriangleMesh> parseObj(std::string_view text, std::string_view source = "OBJ text");
   /// readObj() followed by fromMesh().
   static Result<ClothModel> loadObj(const std::string& path, const MeshSettings& settings = {});
 
