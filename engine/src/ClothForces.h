@@ -40,6 +40,9 @@ struct ClothForceSettings {
   Vec3 gravity{0.0, -9.81, 0.0};                ///< m/s²
   Vec3 wind{0.0, 0.0, 0.0};                     ///< m/s, air velocity for the drag force
   StiffnessMode stiffnessMode = StiffnessMode::Definite;  ///< Jacobian treatment (keep Definite)
+  /// Leave out terms whose coefficients are all zero: bending hinges without bending stiffness
+  /// or damping, damping Jacobians without damping. Exact; false evaluates them anyway (checks).
+  bool skipZeroTerms = true;
 };
 
 class ClothForces {
@@ -69,6 +72,15 @@ class ClothForces {
     return {m_triangleColours.size() - 1, m_hingeColours.size() - 1, m_springColours.size() - 1};
   }
   const ClothForceSettings& settings() const { return m_settings; }
+  /// Changes gravity (m/s²) and air velocity (m/s) for later evaluations.
+  void setExternalFields(const Vec3& gravity, const Vec3& wind) {
+    m_settings.gravity = gravity;
+    m_settings.wind = wind;
+  }
+  /// True when evaluations include the bending hinges.
+  bool evaluatesBending() const { return !m_hinges.empty(); }
+  /// True when assemblies form damping Jacobians (∂f/∂v of the element dampers).
+  bool formsDampingJacobians() const { return m_damping; }
 
  private:
   struct Pass;  // one evaluation: what to compute and where to put it
@@ -98,6 +110,7 @@ class ClothForces {
   TaskSystem* m_tasks = nullptr;
   std::unique_ptr<TaskSystem> m_serialTasks;  // used when m_tasks is null; reused, so no allocation
   bool m_bending = false;  // bending stiffness or damping non-zero
+  bool m_damping = true;   // some element damping non-zero (or skipZeroTerms off)
 };
 
 }  // namespace weft
