@@ -246,7 +246,8 @@ StepStatus World::step(Real frameDt, const StepBudget& budget) {
                      std::isfinite(budget.loosestCgTolerance) && budget.loosestCgTolerance > 0 &&
                      budget.loosestCgTolerance < 1 && budget.fewestCgIterations >= 1 &&
                      budget.fewestSubsteps >= 1 && budget.costSmoothing > 0 &&
-                     budget.costSmoothing <= 1 && budget.headroom > 0 && budget.headroom <= 1;
+                     budget.costSmoothing <= 1 && budget.headroom > 0 && budget.headroom <= 1 &&
+                     budget.strainGuard > 0;
   if (!valid) {
     m_stats.status = StepStatus::InvalidInput;
     return m_stats.status;
@@ -268,7 +269,9 @@ StepStatus World::step(Real frameDt, const StepBudget& budget) {
     defaults.allImplicit = defaults.allImplicit && solver.integrator == IntegratorKind::ImplicitEuler;
     first = false;
   }
-  const StepPlan plan = first ? StepPlan{} : m_costModel->plan(budget, defaults);
+  // The strain guard: after a frame that stretched the cloth beyond it, run the full settings.
+  const bool guarded = !(m_stats.maxStrain <= budget.strainGuard);
+  const StepPlan plan = (first || guarded) ? StepPlan{} : m_costModel->plan(budget, defaults);
   const StepStatus status =
       stepWithPlan(frameDt, plan, budget.milliseconds, budget.costSmoothing, defaults.cgTolerance);
   return status;
