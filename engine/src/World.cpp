@@ -233,8 +233,12 @@ StepStatus World::step(Real frameDt) {
 }
 
 StepStatus World::step(Real frameDt, const StepPlan& plan) {
+  Index mostSubsteps = 0;  // a plan may not ask for more substeps than any cloth allows itself
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (slot->cloth) mostSubsteps = std::max(mostSubsteps, slot->cloth->settings().solver.maxSubsteps);
+  }
   if (!(std::isfinite(plan.cgTolerance) && plan.cgTolerance >= 0 && plan.cgTolerance < 1) ||
-      plan.cgMaxIterations < 0) {
+      plan.cgMaxIterations < 0 || plan.substeps > mostSubsteps) {
     m_stats.status = StepStatus::InvalidInput;
     return m_stats.status;
   }

@@ -119,6 +119,9 @@ TEST(Budget, InvalidBudgetsAndPlansAreRefusedWithoutChange) {
   badPlan.cgTolerance = 0;
   badPlan.cgMaxIterations = -3;
   EXPECT_EQ(scene.world().step(CurtainScene::kFrameDt, badPlan), StepStatus::InvalidInput);
+  badPlan.cgMaxIterations = 0;
+  badPlan.substeps = 1000000;  // beyond SolverSettings::maxSubsteps
+  EXPECT_EQ(scene.world().step(CurtainScene::kFrameDt, badPlan), StepStatus::InvalidInput);
   EXPECT_EQ(scene.world().stateHash(), hash);
   EXPECT_EQ(scene.world().time(), time);
 }

@@ -80,7 +80,10 @@ struct StepStats {
   Index colliderNarrowPhases = 0;  ///< cloth–collider pairs tested (constraint and response passes)
   Index colliderNarrowPhasesSkipped = 0;  ///< pairs skipped: the collider's box is not near the cloth's
   Index selfCollisionPasses = 0;   ///< self-collision passes run (BVH refit, queries, response)
-  Index selfCollisionSkipped = 0;  ///< passes skipped: off, or the cloth cannot fold onto itself
+  /// Passes skipped because the cloth provably cannot touch itself in that substep (FoldCulling:
+  /// no fold, and features farther apart than the thickness plus twice the step's motion). A
+  /// cloth with ClothSettings::selfCollision off counts neither run nor skipped passes.
+  Index selfCollisionSkipped = 0;
   Index bendingAssemblies = 0;     ///< force evaluations that included the bending hinges
   Index dampingJacobians = 0;      ///< assemblies that formed damping (∂f/∂v) Jacobians
   Index sleepingCloths = 0;        ///< cloths asleep during this frame (not stepped)

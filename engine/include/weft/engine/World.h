@@ -176,7 +176,8 @@ class World {
   StepStatus step(Real frameDt, const StepBudget& budget);
   /// Advances by frameDt running exactly `plan` (e.g. a StepStats::plan recorded by a budgeted
   /// run): the same plan from the same state gives the same bits. Invalid plan fields (negative
-  /// or non-finite) are refused with StepStatus::InvalidInput.
+  /// or non-finite, a tolerance of 1 or more, more substeps than any cloth's
+  /// SolverSettings::maxSubsteps) are refused with StepStatus::InvalidInput and nothing changes.
   StepStatus step(Real frameDt, const StepPlan& plan);
   /// Statistics of the last step().
   const StepStats& stats() const { return m_stats; }
