@@ -48,6 +48,9 @@ struct FrameRecord {
   double potentialEnergy = 0;
   unsigned substeps = 0;
   StepStatus status = StepStatus::Ok;
+  double engineMs = 0;          // step() as the engine measured it (what the budget is about)
+  StepPlan plan;
+  bool sleeping = false;
 };
 
 // Creates the folder a file will go into; false (with a message) when that is impossible.
@@ -82,6 +85,8 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   settings.solver.integrator = options.integrator;
   settings.threadCount = int(options.threads);
   settings.selfCollision = options.selfCollision;
+  settings.skipUnneededStages = options.skips;
+  settings.sleep = options.sleep;
   Result<CurtainScene> created = CurtainScene::create(settings);
   if (!created.ok()) {
     out << "weft-curtain: " << created.error().message << "\n";
@@ -161,8 +166,12 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   }
   if (options.budgetMs > 0) {
     out << "  budget     " << options.budgetMs
-        << " ms per frame: misses are counted; the engine does not adapt to it yet\n";
+        << " ms per frame, planned by the engine (PCG tolerance down to "
+        << StepBudget{}.loosestCgTolerance << ", at least " << StepBudget{}.fewestCgIterations
+        << " iterations); misses from StepStats\n";
   }
+  out << "  skips      " << (options.skips ? "on" : "off") << ", sleep "
+      << (options.sleep ? "on" : "off") << "\n";
   out << std::flush;
 
   if (!options.trace.empty()) {
@@ -177,7 +186,9 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   const auto runStart = Clock::now();
   for (unsigned frame = 0; frame < options.frames; ++frame) {
     const auto frameStart = Clock::now();
-    const StepStatus status = scene.stepFrame();
+    StepBudget budget;
+    budget.milliseconds = options.budgetMs;
+    const StepStatus status = options.budgetMs > 0 ? scene.stepFrame(budget) : scene.stepFrame();
     FrameRecord record;
     record.simulationMs = millisecondsSince(frameStart);
 #if WEFT_HAVE_RENDER
@@ -205,13 +216,16 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
     record.potentialEnergy = stats.potentialEnergy;
     record.substeps = stats.substeps;
     record.status = status;
+    record.engineMs = stats.stepMs;
+    record.plan = stats.plan;
+    record.sleeping = stats.sleepingCloths > 0;
     nonfinite = nonfinite || hasFlag(status, StepStatus::RolledBack);
     if (intersectionCounter) {
       const Index pairs = intersectionCounter->count(scene.world().positions(scene.cloth()).value());
       maxIntersections = std::max(maxIntersections, pairs);
       framesWithIntersections += pairs > 0;
     }
-    if (options.budgetMs > 0 && record.simulationMs > options.budgetMs) ++budgetMisses;
+    if (hasFlag(status, StepStatus::BudgetMissed)) ++budgetMisses;
     records.push_back(record);
     if (options.progress && (frame + 1) % 60 == 0) {
       out << "  t = " << std::setw(4) << std::fixed << std::setprecision(1)
@@ -251,10 +265,13 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   const std::vector<double> assemblyMs = column([](const FrameRecord& r) { return r.assemblyMs; });
   const std::vector<double> solveMs = column([](const FrameRecord& r) { return r.solveMs; });
   const std::vector<double> iterations = column([](const FrameRecord& r) { return r.cgIterations; });
-  double maxStrain = 0;
-  unsigned unconverged = 0, unstable = 0;
+  double maxStrain = 0, maxResidual = 0;
+  unsigned unconverged = 0, unstable = 0, relaxedFrames = 0, sleepingFrames = 0;
   for (const FrameRecord& r : records) {
     maxStrain = std::max(maxStrain, r.maxStrain);
+    maxResidual = std::max(maxResidual, r.cgResidual);
+    relaxedFrames += !(r.plan == StepPlan{});
+    sleepingFrames += r.sleeping;
     unconverged += hasFlag(r.status, StepStatus::SolverNotConverged);
     unstable += hasFlag(r.status, StepStatus::Unstable);
   }
@@ -288,7 +305,14 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
       << "  unstable       " << unstable << " frame(s), non-finite: " << (nonfinite ? "yes" : "no")
       << "\n"
       << "  state hash     " << hex(hash) << "\n";
-  if (options.budgetMs > 0) out << "  budget misses  " << budgetMisses << "\n";
+  if (options.budgetMs > 0) {
+    out << "  budget misses  " << budgetMisses << " of " << records.size() << " frames (hit rate "
+        << std::setprecision(1) << 100.0 * (1.0 - double(budgetMisses) / records.size())
+        << " %), " << relaxedFrames << " frame(s) ran a relaxed plan\n"
+        << std::setprecision(5) << "  accuracy       largest PCG residual " << maxResidual
+        << ", largest strain " << maxStrain << "\n";
+  }
+  out << "  asleep         " << sleepingFrames << " frame(s)\n";
   if (intersectionCounter) {
     out << "  intersections  " << maxIntersections << " pairs at most, in "
         << framesWithIntersections << " frame(s)\n";
@@ -344,6 +368,12 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
          intersectionCounter ? std::int64_t(framesWithIntersections) : std::int64_t(-1)},
         {"nonfinite", nonfinite},
         {"budget_misses", budgetMisses},
+        {"budget_ms", options.budgetMs},
+        {"budget_relaxed_frames", relaxedFrames},
+        {"cg_residual_max", maxResidual},
+        {"sleeping_frames", sleepingFrames},
+        {"skips", options.skips},
+        {"sleep", options.sleep},
         {"state_hash", hex(hash)},
         {"render", rendering ? std::to_string(options.renderWidth) + "x" + std::to_string(options.renderHeight) : std::string("off")},
         {"overlap", rendering && options.overlap},
@@ -366,7 +396,8 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
       return 1;
     }
     file << "frame,sim_ms,assembly_ms,solve_ms,render_ms,frame_ms,substeps,cg_iterations,"
-            "cg_residual,max_strain,kinetic_energy,potential_energy,status\n";
+            "cg_residual,max_strain,kinetic_energy,potential_energy,status,engine_ms,"
+            "plan_substeps,plan_cg_tolerance,plan_cg_max_iterations,sleeping\n";
     file << std::setprecision(9);
     for (std::size_t k = 0; k < records.size(); ++k) {
       const FrameRecord& r = records[k];
@@ -374,7 +405,8 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
            << r.renderMs << ',' << r.frameMs << ','
            << r.substeps << ',' << r.cgIterations << ',' << r.cgResidual << ',' << r.maxStrain
            << ',' << r.kineticEnergy << ',' << r.potentialEnergy << ',' << describe(r.status)
-           << '\n';
+           << ',' << r.engineMs << ',' << r.plan.substeps << ',' << r.plan.cgTolerance << ','
+           << r.plan.cgMaxIterations << ',' << r.sleeping << '\n';
     }
     out << "  per-frame CSV  " << options.frameCsv << "\n";
   }

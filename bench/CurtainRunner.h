@@ -22,7 +22,11 @@ struct CurtainRunOptions {
   unsigned renderHeight = 720;     ///< pixels
   bool selfCollision = true;       ///< self-collision on (needs the collision module)
   bool checkIntersections = false; ///< count intersecting triangle pairs every frame (untimed)
-  double budgetMs = 0;             ///< simulation budget per frame in ms; 0 = none
+  /// Simulation budget per frame in ms, handed to the engine (World::step(frameDt, budget)),
+  /// which plans each frame to fit and reports misses; 0 = none.
+  double budgetMs = 0;
+  bool skips = true;               ///< skip stages the scene does not need (off: run every stage)
+  bool sleep = true;               ///< let the curtain sleep when at rest
   std::string captureDirectory;    ///< where PNG frames go; empty = no capture
   std::string summaryJson;         ///< JSON summary path; empty = none
   std::string frameCsv;            ///< per-frame CSV path; empty = none

@@ -25,8 +25,15 @@ int main(int argc, char** argv) {
   app.add_option("--capture", options.captureDirectory, "Directory for PNG frames");
   app.add_flag("--check-intersections", options.checkIntersections,
                "Count intersecting triangle pairs every frame (not timed)");
-  app.add_option("--budget-ms", options.budgetMs, "Simulation budget per frame in ms")
+  app.add_option("--budget-ms", options.budgetMs,
+                 "Simulation budget per frame in ms: the engine plans each frame to fit it and "
+                 "reports misses (0 = none)")
       ->check(CLI::NonNegativeNumber);
+  std::string skips = "on", sleep = "on";
+  app.add_option("--skips", skips, "Skip stages the scene does not need: on or off")
+      ->check(CLI::IsMember({"on", "off"}));
+  app.add_option("--sleep", sleep, "Let the curtain sleep at rest: on or off")
+      ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--summary-json", options.summaryJson, "Write the JSON summary here");
   app.add_option("--csv", options.frameCsv, "Write per-frame statistics here (CSV)");
   app.add_option("--trace", options.trace,
@@ -49,6 +56,8 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   options.selfCollision = selfCollision == "on";
+  options.skips = skips == "on";
+  options.sleep = sleep == "on";
   options.progress = !quiet;
   options.overlap = overlap == "on";
   if (render == "off") {

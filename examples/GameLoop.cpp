@@ -1,14 +1,18 @@
 // GameLoop: how a game drives Weft. The display runs at whatever rate it gets; the simulation
 // runs at a fixed 60 Hz, fed by an accumulator ("Fix Your Timestep", Glenn Fiedler 2004):
 //
-//   every display frame:  accumulator += frame time
-//                         while accumulator >= 1/60 s:  move the pins, World::step(1/60 s)
-//                         draw: blend the last two simulation states by accumulator / (1/60 s)
+//   every display frame:  steps = accumulator.advance(frame time)     (weft::FixedStepAccumulator)
+//                         repeat steps times:  move the pins, World::step(1/60 s)
+//                         draw: blend the last two simulation states by accumulator.alpha()
 //
 // A fixed step keeps the simulation independent of the frame rate: the same inputs give the same
 // bits whether the game draws at 40 or 140 Hz, and the solver never sees a step longer than the
 // one it was tuned for. Here the "display" frame times are a pseudo-random 7–25 ms sequence from
 // a fixed seed, so the output (state hash included) is the same on every run and thread count.
+// A game short of time would call World::step(dt, StepBudget{.milliseconds = 4}) instead: the
+// engine then plans each step from measured costs, which makes the bits depend on the machine's
+// load (the plans it ran are in StepStats::plan, and World::step(dt, plan) replays them exactly).
+// This example keeps the fixed settings so that its output is reproducible.
 //
 // The cloth is a 21×15 sheet held out level from a rod along one edge: it falls, swings down and
 // hangs, while the rod sways side to side and the pinned edge follows it (World::setPinTargets).
@@ -38,32 +42,6 @@ constexpr double kSimulationDt = 1.0 / 60.0;  // s, the fixed simulation step
 constexpr int kMaxStepsPerDisplayFrame = 4;
 constexpr double kRodAmplitude = 0.25;  // m, how far the rod sways either side
 constexpr double kRodPeriod = 2.0;      // s, one full sway
-
-// A fixed-timestep accumulator. It belongs in the engine (or the game's own framework) and may
-// move there; it is kept local to this example until then, so the example shows every step.
-class FixedStepAccumulator {
- public:
-  explicit FixedStepAccumulator(double step) : m_step(step) {}
-
-  /// Adds a display frame's time (s); returns how many fixed steps to take now.
-  int advance(double frameTime) {
-    m_accumulated += frameTime;
-    int steps = static_cast<int>(std::floor(m_accumulated / m_step));
-    if (steps > kMaxStepsPerDisplayFrame) {
-      // Drop the backlog rather than let it grow without bound.
-      steps = kMaxStepsPerDisplayFrame;
-      m_accumulated = steps * m_step;
-    }
-    m_accumulated -= steps * m_step;
-    return steps;
-  }
-  /// How far the display time lies between the last two fixed steps, in [0, 1).
-  double alpha() const { return m_accumulated / m_step; }
-
- private:
-  double m_step;
-  double m_accumulated = 0;
-};
 
 // Display frame times of 7–25 ms from a fixed seed. The arithmetic of std::minstd_rand is fixed
 // by the standard but the distributions are not, so the range mapping is done by hand.
@@ -133,7 +111,8 @@ int main(int argc, char** argv) {
   }
   const weft::ClothId cloth = created.value();
 
-  FixedStepAccumulator accumulator(kSimulationDt);
+  weft::FixedStepAccumulator accumulator(kSimulationDt, kMaxStepsPerDisplayFrame);
+
   FrameTimeSequence frameTimes;
   std::vector<weft::Vec3> pinTargets(rodPoints.size());
   // The state before the latest step: drawing blends it with the current one by alpha().
@@ -167,7 +146,7 @@ int main(int argc, char** argv) {
         auto current = world.positions(cloth);
         if (current) previous.assign(current->begin(), current->end());
       }
-      const weft::StepStatus status = world.step(kSimulationDt);
+      const weft::StepStatus status = world.step(accumulator.step());
       ++simulationSteps;
       if (weft::hasFlag(status, weft::StepStatus::RolledBack) ||
           weft::hasFlag(status, weft::StepStatus::InvalidInput)) {
@@ -207,9 +186,10 @@ int main(int argc, char** argv) {
     }
   }
 
-  std::printf("game-loop: ok, %d display frames, %ld simulation steps, %d not converged, "
-              "max strain %.4f, state hash %016" PRIx64 "\n",
-              displayFrames, simulationSteps, notConverged, world.stats().maxStrain,
-              world.stateHash());
+  std::printf("game-loop: ok, %d display frames, %ld simulation steps (%llu dropped after "
+              "stalls), %d not converged, max strain %.4f, state hash %016" PRIx64 "\n",
+              displayFrames, simulationSteps,
+              static_cast<unsigned long long>(accumulator.droppedSteps()), notConverged,
+              world.stats().maxStrain, world.stateHash());
   return 0;
 }

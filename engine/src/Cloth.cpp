@@ -22,6 +22,36 @@ constexpr Real kStableStepSafety = 0.9;
 constexpr Real kDivergedSpeed = 1e4;
 // Retries of a failed frame, each with twice the substeps: up to 8 times the planned number.
 constexpr int kMaxRetries = 3;
+// A sleeping cloth watches colliders within this distance (m) beyond its contact thickness: far
+// enough that a collider cannot reach it unseen within a frame unless it moves (and a moving
+// collider near it wakes it anyway), near enough that distant traffic leaves it asleep.
+constexpr Real kWakeMargin = 0.01;
+
+// A point farther than this from a box that holds a shape is farther than `thickness` from the
+// shape, with room for the round-off of the distance queries: skipping the narrow phase of such a
+// collider changes no bit.
+Real contactMargin(Real thickness) { return thickness * (1 + 1e-6) + 1e-9; }
+
+// True when some point of `points` may lie within `margin` of the shape.
+bool colliderNear(const Shape& shape, const Aabb& points, Real margin) {
+  if (points.isEmpty()) return false;
+  Aabb box = bounds(shape);
+  box.inflate(margin);
+  if (!box.overlaps(points)) return false;
+  if (const Plane* plane = std::get_if<Plane>(&shape)) {
+    // A tilted half-space has an unbounded box; its signed distance is linear, so the corners of
+    // the points' box bound it from below.
+    Real nearest = std::numeric_limits<Real>::infinity();
+    for (int corner = 0; corner < 8; ++corner) {
+      const Vec3 point((corner & 1) ? points.max.x() : points.min.x(),
+                       (corner & 2) ? points.max.y() : points.min.y(),
+                       (corner & 4) ? points.max.z() : points.min.z());
+      nearest = std::min(nearest, plane->queryPoint(point).distance);
+    }
+    return nearest < margin;
+  }
+  return true;
+}
 
 std::string checkNonNegative(const char* field, Real value, const char* unit) {
   if (std::isfinite(value) && value >= 0) return {};
@@ -109,7 +139,8 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
       m_settings(settings),
       m_forces(*m_model,
                ClothForceSettings{settings.forceModel, settings.material, settings.springs,
-                                  world.gravity, world.wind, StiffnessMode::Definite},
+                                  world.gravity, world.wind, StiffnessMode::Definite,
+                                  world.skipUnneededStages},
                std::move(masses), tasks) {
   const std::vector<std::array<Index, 2>> pairs = m_forces.coupledPairs();
   m_matrix.build(m_model->vertexCount(), pairs);
@@ -143,7 +174,11 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   m_inverseMasses.resize(n);
   const std::vector<Real>& mass = m_forces.masses();
   for (Index i = 0; i < n; ++i) m_inverseMasses[i] = m_pinnedMask[i] ? 0 : 1 / mass[i];
-  if (settings.selfCollision) m_selfCollision = std::make_unique<SelfCollision>(*m_model, tasks);
+  if (settings.selfCollision) {
+    m_selfCollision = std::make_unique<SelfCollision>(*m_model, tasks);
+    m_foldCulling = std::make_unique<FoldCulling>(*m_model);
+  }
+  m_skipStages = world.skipUnneededStages;
   estimateStiffestMode();
 }
 
@@ -203,11 +238,14 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
 }
 
 Real Cloth::computeForces(const Vec3Array& x, const Vec3Array& v, Real, Vec3Array& f) {
+  m_stages.bendingAssemblies += m_forces.evaluatesBending();
   return m_forces.computeForces(x, v, f);
 }
 
 Real Cloth::linearize(const Vec3Array& x, const Vec3Array& v, Real, Real h, Vec3Array& f,
                       const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) {
+  m_stages.bendingAssemblies += m_forces.evaluatesBending();
+  m_stages.dampingJacobians += m_forces.formsDampingJacobians();
   return m_forces.assemble(x, v, h, m_matrix, f, velocityForProduct, stiffnessTimesVelocity);
 }
 
@@ -255,6 +293,7 @@ Status Cloth::setExternalForces(std::span<const Vec3> forces) {
     }
   }
   m_forces.setExternalForces(forces);
+  m_wakeRequested = true;
   return Status::success();
 }
 
@@ -277,13 +316,59 @@ Status Cloth::setState(std::span<const Vec3> positions, std::span<const Vec3> ve
   for (std::size_t k = 0; k < pins.size(); ++k) m_pinStart[k] = m_pinEnd[k] = m_positions[pins[k]];
   m_integrator->reset();  // the previous Δv means nothing for the new state
   m_normalsValid = false;
+  m_sleeping = false;
+  m_quietFrames = 0;
   return Status::success();
+}
+
+void Cloth::setExternalFields(const Vec3& gravity, const Vec3& wind) {
+  m_forces.setExternalFields(gravity, wind);
+  m_wakeRequested = true;
+}
+
+void Cloth::selectNearColliders(std::span<const ColliderFrame> colliders, const Aabb& points,
+                                const Aabb* carriedStart) {
+  m_nearColliders.clear();
+  const Real margin = contactMargin(m_settings.material.thickness);
+  for (const ColliderFrame& collider : colliders) {
+    bool near = !m_skipStages;
+    if (!near) {
+      // The response also follows each vertex's start point carried with the body; for a body
+      // that did not move in the step that is the start point itself (to round-off).
+      const bool moved = !(collider.start.pose.position == collider.end.pose.position &&
+                           collider.start.pose.rotation.coeffs() == collider.end.pose.rotation.coeffs());
+      Aabb box = points;
+      if (carriedStart && !moved) box.expand(*carriedStart);
+      if (carriedStart && moved) {
+        for (Index i = 0; i < vertexCount(); ++i) {
+          if (!m_pinnedMask[i]) {
+            box.expand(collider.end.pose.toWorld(collider.start.pose.toLocal(m_stepStartPositions[i])));
+          }
+        }
+      }
+      near = colliderNear(*collider.shape, box, margin);
+    }
+    if (near) {
+      m_nearColliders.push_back(collider);
+      ++m_stages.colliderNarrowPhases;
+    } else {
+      ++m_stages.colliderNarrowPhasesSkipped;
+    }
+  }
 }
 
 void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                               VertexFilter& filter) {
-  m_colliderResponse.constrain(m_colliders, x, v, h, m_settings.material.thickness, m_pinnedMask,
-                               filter);
+  // The constraint pass tests the predicted positions x + h v of free vertices.
+  Aabb predicted = Aabb::empty();
+  if (m_skipStages && !m_colliders.empty()) {
+    for (Index i = 0; i < vertexCount(); ++i) {
+      if (!m_pinnedMask[i]) predicted.expand(Vec3(x[i] + h * v[i]));
+    }
+  }
+  selectNearColliders(m_colliders, predicted, nullptr);
+  m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
+                               m_pinnedMask, filter);
 }
 
 bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
@@ -304,12 +389,28 @@ bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<Collider
     }
     m_integrator->step(*this, m_positions, m_velocities, t + substep * h, h, substepReport);
     if (!colliders.empty()) {
+      // The response tests the end positions and the segments from the (carried) start points.
+      Aabb end = Aabb::empty(), start = Aabb::empty();
+      if (m_skipStages) {
+        for (Index i = 0; i < vertexCount(); ++i) {
+          if (m_pinnedMask[i]) continue;
+          end.expand(m_positions[i]);
+          start.expand(m_stepStartPositions[i]);
+        }
+      }
+      selectNearColliders(colliders, end, &start);
       const ColliderResponseReport contact = m_colliderResponse.resolve(
-          colliders, m_stepStartPositions, m_stepStartVelocities, m_settings.material.thickness,
-          m_pinnedMask, m_positions, m_velocities);
+          m_nearColliders, m_stepStartPositions, m_stepStartVelocities,
+          m_settings.material.thickness, m_pinnedMask, m_positions, m_velocities);
       report.contacts = contact.contacts;
     }
-    if (m_selfCollision) {
+    const bool selfCollisionNeeded =
+        m_selfCollision && !(m_skipStages && m_foldCulling->cannotTouchItself(
+                                                 m_stepStartPositions, m_positions,
+                                                 m_settings.material.thickness));
+    if (m_selfCollision && !selfCollisionNeeded) ++m_stages.selfCollisionSkipped;
+    if (selfCollisionNeeded) {
+      ++m_stages.selfCollisionPasses;
       const SelfCollisionReport self = m_selfCollision->resolve(
           m_stepStartPositions, h, m_settings.material.thickness, m_settings.material.friction,
           m_inverseMasses, m_positions, m_velocities);
@@ -343,6 +444,10 @@ void Cloth::save(SavedState& out) const {
   out.velocities = m_velocities;
   out.pinTargets = m_pinEnd;
   m_integrator->saveCarriedState(out.carried);
+  out.sleeping = m_sleeping;
+  out.wakeRequested = m_wakeRequested;
+  out.quietFrames = m_quietFrames;
+  out.sleepFingerprint = m_sleepFingerprint;
 }
 
 void Cloth::restore(const SavedState& in) {
@@ -351,13 +456,99 @@ void Cloth::restore(const SavedState& in) {
   m_pinStart = m_pinEnd = in.pinTargets;
   m_integrator->restoreCarriedState(in.carried);
   m_normalsValid = false;
+  m_sleeping = in.sleeping;
+  m_wakeRequested = in.wakeRequested;
+  m_quietFrames = in.quietFrames;
+  m_sleepFingerprint = in.sleepFingerprint;
 }
 
-ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame> colliders) {
+std::uint64_t Cloth::colliderFingerprint(std::span<const ColliderFrame> colliders, Real frameDt,
+                                         bool* anyMoving) const {
+  Aabb cloth = Aabb::empty();
+  for (const Vec3& x : m_positions) cloth.expand(x);
+  const Real margin = contactMargin(m_settings.material.thickness) + kWakeMargin;
+  std::uint64_t hash = 1469598103934665603ull;
+  auto mix = [&hash](const void* data, std::size_t bytes) {
+    const unsigned char* byte = static_cast<const unsigned char*>(data);
+    for (std::size_t k = 0; k < bytes; ++k) hash = (hash ^ byte[k]) * 1099511628211ull;
+  };
+  *anyMoving = false;
+  for (std::size_t k = 0; k < colliders.size(); ++k) {
+    const RigidMotion& motion = colliders[k].start;
+    const bool moving = !motion.linearVelocity.isZero() || !motion.angularVelocity.isZero();
+    Real reach = margin;
+    if (moving) {
+      // Where the body can get within the frame: its travel, and for a spinning body the sweep
+      // of its box about its origin.
+      const Aabb box = bounds(*colliders[k].shape);
+      const Real radius = std::max((box.min - motion.pose.position).norm(),
+                                   (box.max - motion.pose.position).norm());
+      reach += frameDt * (motion.linearVelocity.norm() + motion.angularVelocity.norm() * radius);
+      if (!std::isfinite(reach)) reach = std::numeric_limits<Real>::max();
+    }
+    if (!colliderNear(*colliders[k].shape, cloth, reach)) continue;
+    *anyMoving = *anyMoving || moving;
+    mix(&k, sizeof k);
+    mix(motion.pose.position.data(), sizeof(Real) * 3);
+    mix(motion.pose.rotation.coeffs().data(), sizeof(Real) * 4);
+  }
+  return hash;
+}
+
+void Cloth::updateSleep(std::span<const ColliderFrame> colliders, Real frameDt, bool pinsMoved) {
+  const SleepSettings& sleep = m_settings.sleep;
+  if (!sleep.enabled) return;
+  // Quiet: every free vertex slow, and its velocity barely changed over the frame — the
+  // residual of M a = f, which is what keeps a cloth released from rest from sleeping.
+  Real speed2 = 0, change2 = 0;
+  for (Index i = 0; i < vertexCount(); ++i) {
+    if (m_pinnedMask[i]) continue;
+    speed2 = std::max(speed2, m_velocities[i].squaredNorm());
+    change2 = std::max(change2, (m_velocities[i] - m_savedVelocities[i]).squaredNorm());
+  }
+  const bool quiet = !pinsMoved && speed2 < sleep.speed * sleep.speed &&
+                     change2 < (sleep.acceleration * frameDt) * (sleep.acceleration * frameDt);
+  m_quietFrames = quiet ? m_quietFrames + 1 : 0;
+  if (m_quietFrames < sleep.frames) return;
+  bool anyMoving = false;
+  const std::uint64_t fingerprint = colliderFingerprint(colliders, frameDt, &anyMoving);
+  if (anyMoving) return;  // a body moves near it: stay awake
+  m_sleeping = true;
+  m_sleepFingerprint = fingerprint;
+  for (Vec3& v : m_velocities) v.setZero();
+}
+
+ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame> colliders,
+                                  const StepPlan& plan) {
   ClothFrameReport report;
+  m_stages = ClothStageCounters{};
+  const bool pinsMoved = m_pinStart != m_pinEnd;
+  if (m_sleeping) {
+    bool anyMoving = false;
+    const bool collidersChanged =
+        colliderFingerprint(colliders, frameDt, &anyMoving) != m_sleepFingerprint || anyMoving;
+    if (!m_wakeRequested && !pinsMoved && !collidersChanged) {
+      report.sleeping = true;
+      return report;
+    }
+    m_sleeping = false;
+    m_quietFrames = 0;
+    report.woke = true;
+  }
+  m_wakeRequested = false;
+
   bool predictedUnstable = false;
   Index substeps = plannedSubsteps(frameDt, &predictedUnstable);
+  if (plan.substeps > 0) {
+    substeps = plan.substeps;
+    predictedUnstable = m_settings.solver.integrator != IntegratorKind::ImplicitEuler &&
+                        frameDt / substeps > m_stableStep;
+  }
   if (predictedUnstable) report.status |= StepStatus::Unstable;
+  m_integrator->setSolveLimits(
+      plan.cgTolerance > 0 ? plan.cgTolerance : m_settings.solver.cgTolerance,
+      plan.cgMaxIterations > 0 ? plan.cgMaxIterations : m_settings.solver.cgMaxIterations);
+  m_nearColliders.reserve(colliders.size());  // allocates only when colliders are added
 
   m_savedPositions = m_positions;
   m_savedVelocities = m_velocities;
@@ -392,6 +583,12 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
   if (!report.integrator.cgConverged) report.status |= StepStatus::SolverNotConverged;
   m_pinStart = m_pinEnd;  // next frame starts where this one ended
   m_normalsValid = false;
+  if (hasFlag(report.status, StepStatus::Unstable)) {
+    m_quietFrames = 0;
+  } else {
+    updateSleep(colliders, frameDt, pinsMoved);
+  }
+  report.stages = m_stages;
   return report;
 }
 

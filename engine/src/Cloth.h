@@ -7,19 +7,34 @@
 
 #include "ClothForces.h"
 #include "ColliderResponse.h"
+#include "FoldCulling.h"
 #include "SelfCollision.h"
 #include "integrators/Integrator.h"
 #include "solver/BlockSparseMatrix.h"
 
+#include <weft/collision/Aabb.h>
 #include <weft/engine/World.h>
 
 #include <memory>
 
 namespace weft {
 
+/// Stages one frame of one cloth ran and skipped (see the StepStats fields of the same names).
+struct ClothStageCounters {
+  Index colliderNarrowPhases = 0;
+  Index colliderNarrowPhasesSkipped = 0;
+  Index selfCollisionPasses = 0;
+  Index selfCollisionSkipped = 0;
+  Index bendingAssemblies = 0;
+  Index dampingJacobians = 0;
+};
+
 /// Result of advancing one cloth by one frame.
 struct ClothFrameReport {
   Index substeps = 0;
+  ClothStageCounters stages;
+  bool sleeping = false;  ///< the cloth slept through the frame (not stepped)
+  bool woke = false;      ///< the cloth was asleep and woke at the start of the frame
   SelfCollisionReport selfCollision;  ///< summed over substeps
   Index contacts = 0;  ///< vertices touching colliders at the end of the frame
   IntegratorReport integrator;
@@ -49,7 +64,14 @@ class Cloth final : public DynamicSystem {
   /// Advances by one frame of length frameDt starting at world time t, against colliders whose
   /// motions are given at the frame start (their shapes are posed per substep and left posed at
   /// the end of the last substep).
-  ClothFrameReport stepFrame(Real t, Real frameDt, std::span<ColliderFrame> colliders = {});
+  /// `plan` overrides substeps and PCG limits where its fields are non-zero (frame budget).
+  ClothFrameReport stepFrame(Real t, Real frameDt, std::span<ColliderFrame> colliders = {},
+                             const StepPlan& plan = {});
+  /// Changes gravity and wind (validated by the caller) and wakes the cloth.
+  void setExternalFields(const Vec3& gravity, const Vec3& wind);
+  /// Wakes the cloth at the start of its next frame (no effect when awake).
+  void wake() { m_wakeRequested = true; }
+  bool sleeping() const { return m_sleeping; }
   /// Substeps this cloth takes for a frame of frameDt; `predictedUnstable` is set when an
   /// explicit method would need more than maxSubsteps.
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
@@ -57,8 +79,6 @@ class Cloth final : public DynamicSystem {
   Status setPinTargets(std::span<const Vec3> targets);
   /// N per vertex, added to every evaluation until changed; an empty span removes them.
   Status setExternalForces(std::span<const Vec3> forces);
-  /// m/s, air velocity for the drag force (validated by the World).
-  void setWind(const Vec3& wind) { m_forces.setWind(wind); }
   const Vec3Array& pinTargets() const { return m_pinEnd; }
 
   const Vec3Array& positions() const { return m_positions; }
@@ -72,6 +92,9 @@ class Cloth final : public DynamicSystem {
   /// Everything that decides how this cloth continues (see World::saveState).
   struct SavedState {
     Vec3Array positions, velocities, pinTargets, carried;
+    bool sleeping = false, wakeRequested = false;
+    Index quietFrames = 0;
+    std::uint64_t sleepFingerprint = 0;
   };
   void save(SavedState& out) const;
   /// Restores a save of this cloth (sizes checked by the caller).
@@ -96,6 +119,16 @@ class Cloth final : public DynamicSystem {
   // Runs `substeps` substeps of the frame; false when the state became non-finite or diverged.
   bool runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
                    ClothFrameReport& report);
+  // Colliders whose box comes within the contact distance of `points` go to m_nearColliders;
+  // counts both kinds in m_stages.
+  void selectNearColliders(std::span<const ColliderFrame> colliders, const Aabb& points,
+                           const Aabb* carriedStart);
+  // Hash of the colliders that could touch the cloth within the coming frame, and whether any of
+  // them moves: what a sleeping cloth watches.
+  std::uint64_t colliderFingerprint(std::span<const ColliderFrame> colliders, Real frameDt,
+                                    bool* anyMoving) const;
+  // After a frame: counts quiet frames and puts the cloth to sleep after enough of them.
+  void updateSleep(std::span<const ColliderFrame> colliders, Real frameDt, bool pinsMoved);
 
   std::shared_ptr<const ClothModel> m_model;
   TaskSystem* m_tasks;
@@ -113,6 +146,13 @@ class Cloth final : public DynamicSystem {
   std::vector<char> m_pinnedMask;      // 1 for pinned vertices
   ColliderResponse m_colliderResponse;
   std::unique_ptr<SelfCollision> m_selfCollision;  // null when ClothSettings::selfCollision is off
+  std::unique_ptr<FoldCulling> m_foldCulling;      // with m_selfCollision
+  bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
+  std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
+  ClothStageCounters m_stages;                     // this frame's
+  bool m_sleeping = false, m_wakeRequested = false;
+  Index m_quietFrames = 0;
+  std::uint64_t m_sleepFingerprint = 0;
   std::vector<Real> m_inverseMasses;               // 0 for pinned vertices
   std::span<const ColliderFrame> m_colliders;  // this substep's colliders
   Vec3Array m_stepStartPositions, m_stepStartVelocities;

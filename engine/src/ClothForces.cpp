@@ -20,6 +20,7 @@ struct ClothForces::Pass {
   BlockSparseMatrix* matrix = nullptr;
   const Vec3Array* velocityForProduct = nullptr;
   Vec3Array* stiffnessTimesVelocity = nullptr;
+  bool damping = true;  // element velocity Jacobians are non-zero
 };
 
 namespace {
@@ -81,7 +82,8 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
       noSlots(element.slots);
       m_triangles.push_back(element);
     }
-    m_bending = settings.material.bendingStiffness != 0 || settings.material.bendingDamping != 0;
+    m_bending = settings.material.bendingStiffness != 0 || settings.material.bendingDamping != 0 ||
+                !settings.skipZeroTerms;
     if (m_bending) {
       m_hinges.reserve(model.hinges().size());
       for (const Hinge& hinge : model.hinges()) {
@@ -114,9 +116,19 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
           break;
       }
       // A spring family switched off costs nothing.
-      if (element.stiffness != 0 || element.damping != 0) m_springs.push_back(element);
+      if (element.stiffness != 0 || element.damping != 0 || !settings.skipZeroTerms) {
+        m_springs.push_back(element);
+      }
     }
   }
+  // Without damping every element velocity Jacobian is exactly +0: leaving it out of the scatter
+  // changes no bit (x − (+0) = x, and no entry is ever −0).
+  const ClothMaterial& m = settings.material;
+  const MassSpringMaterial& k = settings.springs;
+  m_damping = !settings.skipZeroTerms ||
+              (settings.model == ForceModel::BaraffWitkin
+                   ? m.stretchDamping != 0 || m.shearDamping != 0 || (m_bending && m.bendingDamping != 0)
+                   : k.structuralDamping != 0 || k.shearDamping != 0 || k.flexionDamping != 0);
   m_triangleColours = colourElements(m_triangles, model.vertexCount());
   m_hingeColours = colourElements(m_hinges, model.vertexCount());
   m_springColours = colourElements(m_springs, model.vertexCount());
@@ -162,9 +174,13 @@ void scatter(const ElementType& element, const ElementForces<N>& local, const Pa
     Vec3 product = Vec3::Zero();
     for (int b = 0; b < N; ++b) {
       const Mat3 positionBlock = local.positionJacobian.template block<3, 3>(3 * a, 3 * b);
-      pass.matrix->block(element.slots[a * N + b]) -=
-          pass.h * local.velocityJacobian.template block<3, 3>(3 * a, 3 * b) +
-          (pass.h * pass.h) * positionBlock;
+      if (pass.damping) {
+        pass.matrix->block(element.slots[a * N + b]) -=
+            pass.h * local.velocityJacobian.template block<3, 3>(3 * a, 3 * b) +
+            (pass.h * pass.h) * positionBlock;
+      } else {
+        pass.matrix->block(element.slots[a * N + b]) -= (pass.h * pass.h) * positionBlock;
+      }
       product += positionBlock * (*pass.velocityForProduct)[element.vertices[b]];
     }
     (*pass.stiffnessTimesVelocity)[element.vertices[a]] += product;
@@ -303,7 +319,8 @@ Real ClothForces::assemble(const Vec3Array& x, const Vec3Array& v, Real h, Block
   stiffnessTimesVelocity.resize(m_masses.size());
   // Off-diagonal blocks accumulate; diagonal blocks are overwritten with M + h·drag first.
   matrix.setZero();
-  return evaluate(Pass{x, v, f, h, &matrix, &velocityForProduct, &stiffnessTimesVelocity});
+  return evaluate(
+      Pass{x, v, f, h, &matrix, &velocityForProduct, &stiffnessTimesVelocity, m_damping});
 }
 
 }  // namespace weft

@@ -41,6 +41,9 @@ struct ClothForceSettings {
   Vec3 gravity{0.0, -9.81, 0.0};                ///< m/s²
   Vec3 wind{0.0, 0.0, 0.0};                     ///< m/s, air velocity for the drag force
   StiffnessMode stiffnessMode = StiffnessMode::Definite;  ///< Jacobian treatment (keep Definite)
+  /// Leave out terms whose coefficients are all zero: bending hinges without bending stiffness
+  /// or damping, damping Jacobians without damping. Exact; false evaluates them anyway (checks).
+  bool skipZeroTerms = true;
 };
 
 class ClothForces {
@@ -70,14 +73,21 @@ class ClothForces {
     return {m_triangleColours.size() - 1, m_hingeColours.size() - 1, m_springColours.size() - 1};
   }
   const ClothForceSettings& settings() const { return m_settings; }
-  /// m/s, air velocity felt through the drag from the next evaluation on.
-  void setWind(const Vec3& wind) { m_settings.wind = wind; }
   /// N, a force on every vertex added to each evaluation (constant in x and v, so no Jacobian);
   /// empty: none. Sizes and finiteness are checked by the caller.
   void setExternalForces(std::span<const Vec3> forces) {
     m_externalForces.assign(forces.begin(), forces.end());
   }
   const Vec3Array& externalForces() const { return m_externalForces; }
+  /// Changes gravity (m/s²) and air velocity (m/s) for later evaluations.
+  void setExternalFields(const Vec3& gravity, const Vec3& wind) {
+    m_settings.gravity = gravity;
+    m_settings.wind = wind;
+  }
+  /// True when evaluations include the bending hinges.
+  bool evaluatesBending() const { return !m_hinges.empty(); }
+  /// True when assemblies form damping Jacobians (∂f/∂v of the element dampers).
+  bool formsDampingJacobians() const { return m_damping; }
 
  private:
   struct Pass;  // one evaluation: what to compute and where to put it
@@ -108,6 +118,7 @@ class ClothForces {
   TaskSystem* m_tasks = nullptr;
   std::unique_ptr<TaskSystem> m_serialTasks;  // used when m_tasks is null; reused, so no allocation
   bool m_bending = false;  // bending stiffness or damping non-zero
+  bool m_damping = true;   // some element damping non-zero (or skipZeroTerms off)
 };
 
 }  // namespace weft

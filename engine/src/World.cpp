@@ -1,6 +1,7 @@
 #include <weft/engine/World.h>
 
 #include "Cloth.h"
+#include "FrameCostModel.h"
 
 #include <weft/threading/Profiler.h>
 
@@ -25,6 +26,7 @@ std::string describe(StepStatus status) {
   add(StepStatus::RolledBack, "rolled-back");
   add(StepStatus::InvalidInput, "invalid-input");
   add(StepStatus::RetriedWithSmallerStep, "retried-with-smaller-step");
+  add(StepStatus::BudgetMissed, "budget-missed");
   return text;
 }
 
@@ -64,7 +66,8 @@ WorldState& WorldState::operator=(const WorldState& other) {
 WorldState::WorldState(WorldState&&) noexcept = default;
 WorldState& WorldState::operator=(WorldState&&) noexcept = default;
 
-World::World(const WorldSettings& settings) : m_settings(settings) {
+World::World(const WorldSettings& settings)
+    : m_settings(settings), m_costModel(std::make_unique<FrameCostModel>()) {
   if (settings.taskSystem) {
     m_tasks = settings.taskSystem;
   } else {
@@ -271,7 +274,7 @@ Status World::setWind(const Vec3& wind) {
   }
   m_settings.wind = wind;
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-    if (slot->cloth) slot->cloth->setWind(wind);
+    if (slot->cloth) slot->cloth->setExternalFields(m_settings.gravity, m_settings.wind);
   }
   return Status::success();
 }
@@ -306,7 +309,88 @@ void World::updateAttachedPins(Real frameDt) {
   }
 }
 
+Status World::setGravity(const Vec3& gravity) {
+  if (!gravity.allFinite()) return Error{"setGravity: gravity contains NaN or infinity"};
+  m_settings.gravity = gravity;
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (slot->cloth) slot->cloth->setExternalFields(m_settings.gravity, m_settings.wind);
+  }
+  return Status::success();
+}
+
+Status World::wake(ClothId id) {
+  ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("wake", id);
+  slot->cloth->wake();
+  return Status::success();
+}
+
+Result<bool> World::isSleeping(ClothId id) const {
+  const ClothSlot* slot = find(id);
+  if (!slot) return staleHandle("isSleeping", id);
+  return slot->cloth->sleeping();
+}
+
+namespace {
+// Weight of the newest frame in the cost model when steps come without a budget.
+constexpr Real kDefaultCostSmoothing = 0.3;
+}  // namespace
+
 StepStatus World::step(Real frameDt) {
+  return stepWithPlan(frameDt, StepPlan{}, 0, kDefaultCostSmoothing);
+}
+
+StepStatus World::step(Real frameDt, const StepPlan& plan) {
+  Index mostSubsteps = 0;  // a plan may not ask for more substeps than any cloth allows itself
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (slot->cloth) mostSubsteps = std::max(mostSubsteps, slot->cloth->settings().solver.maxSubsteps);
+  }
+  if (!(std::isfinite(plan.cgTolerance) && plan.cgTolerance >= 0 && plan.cgTolerance < 1) ||
+      plan.cgMaxIterations < 0 || plan.substeps > mostSubsteps) {
+    m_stats.status = StepStatus::InvalidInput;
+    return m_stats.status;
+  }
+  return stepWithPlan(frameDt, plan, 0, kDefaultCostSmoothing);
+}
+
+StepStatus World::step(Real frameDt, const StepBudget& budget) {
+  const bool valid = std::isfinite(budget.milliseconds) && budget.milliseconds >= 0 &&
+                     std::isfinite(budget.loosestCgTolerance) && budget.loosestCgTolerance > 0 &&
+                     budget.loosestCgTolerance < 1 && budget.fewestCgIterations >= 1 &&
+                     budget.fewestSubsteps >= 1 && budget.costSmoothing > 0 &&
+                     budget.costSmoothing <= 1 && budget.headroom > 0 && budget.headroom <= 1 &&
+                     budget.strainGuard > 0;
+  if (!valid) {
+    m_stats.status = StepStatus::InvalidInput;
+    return m_stats.status;
+  }
+  if (budget.milliseconds == 0) return step(frameDt);
+  if (!(std::isfinite(frameDt) && frameDt > 0)) return stepWithPlan(frameDt, {}, 0, 1);
+  // What the cloths would run on their own: the planner relaxes from there.
+  PlanDefaults defaults;
+  bool first = true;
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (!slot->cloth || slot->cloth->sleeping()) continue;
+    const Cloth& cloth = *slot->cloth;
+    const SolverSettings& solver = cloth.settings().solver;
+    const Index substeps = cloth.plannedSubsteps(frameDt);
+    defaults.substeps = first ? substeps : std::max(defaults.substeps, substeps);
+    defaults.cgTolerance = first ? solver.cgTolerance : std::min(defaults.cgTolerance, solver.cgTolerance);
+    defaults.cgMaxIterations =
+        first ? solver.cgMaxIterations : std::max(defaults.cgMaxIterations, solver.cgMaxIterations);
+    defaults.allImplicit = defaults.allImplicit && solver.integrator == IntegratorKind::ImplicitEuler;
+    first = false;
+  }
+  // The strain guard: after a frame that stretched the cloth beyond it, run the full settings.
+  const bool guarded = !(m_stats.maxStrain <= budget.strainGuard);
+  const StepPlan plan = (first || guarded) ? StepPlan{} : m_costModel->plan(budget, defaults);
+  const StepStatus status =
+      stepWithPlan(frameDt, plan, budget.milliseconds, budget.costSmoothing, defaults.cgTolerance);
+  return status;
+}
+
+StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs,
+                               Real costSmoothing, Real defaultTolerance) {
   const auto start = std::chrono::steady_clock::now();
   Profiler::instance().beginFrame(m_stats.frame + 1);
   WEFT_PROFILE_ZONE("step");
@@ -316,6 +400,9 @@ StepStatus World::step(Real frameDt) {
   }
   StepStats stats;
   stats.frame = m_stats.frame + 1;
+  stats.plan = plan;
+  stats.budgetMs = budgetMs;
+  Index totalSubsteps = 0;
   // Where the colliders are at the frame start; each cloth steps against them from there (a
   // cloth poses the shapes per substep), and they end the frame advanced by their velocities.
   m_colliderStartMotions.clear();
@@ -336,7 +423,17 @@ StepStatus World::step(Real frameDt) {
       frame.friction = collider->settings.friction;
       m_colliderFrames.push_back(frame);
     }
-    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames);
+    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames, plan);
+    stats.sleepingCloths += report.sleeping;
+    stats.wokenCloths += report.woke;
+    stats.colliderNarrowPhases += report.stages.colliderNarrowPhases;
+    stats.colliderNarrowPhasesSkipped += report.stages.colliderNarrowPhasesSkipped;
+    stats.selfCollisionPasses += report.stages.selfCollisionPasses;
+    stats.selfCollisionSkipped += report.stages.selfCollisionSkipped;
+    stats.bendingAssemblies += report.stages.bendingAssemblies;
+    stats.dampingJacobians += report.stages.dampingJacobians;
+    stats.frozenVertices += report.selfCollision.frozenVertices;
+    totalSubsteps += report.substeps;
     stats.contacts += report.contacts;
     stats.selfContacts += report.selfCollision.proximityContacts;
     stats.selfImpacts += report.selfCollision.impacts;
@@ -362,6 +459,9 @@ StepStatus World::step(Real frameDt) {
   stats.simulatedTime = m_time;
   stats.stepMs =
       std::chrono::duration<Real, std::milli>(std::chrono::steady_clock::now() - start).count();
+  if (budgetMs > 0 && stats.stepMs > budgetMs) stats.status |= StepStatus::BudgetMissed;
+  m_costModel->record(stats, totalSubsteps,
+                      plan.cgTolerance > 0 ? plan.cgTolerance : defaultTolerance, costSmoothing);
   m_stats = stats;
   return stats.status;
 }

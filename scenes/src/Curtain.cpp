@@ -54,6 +54,7 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   WorldSettings worldSettings;
   worldSettings.threadCount = settings.threadCount;
   worldSettings.taskSystem = settings.taskSystem;
+  worldSettings.skipUnneededStages = settings.skipUnneededStages;
   scene.m_world = std::make_unique<World>(worldSettings);
   scene.m_pinScript = settings.pinScript;
 
@@ -62,6 +63,7 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   cloth.material = settings.material;
   cloth.solver = settings.solver;
   cloth.selfCollision = settings.selfCollision;
+  cloth.sleep.enabled = settings.sleep;
   const Index topRow = grid.rows - 1;
   for (Index column = 0; column < grid.columns; ++column) {
     cloth.pinnedVertices.push_back(topRow * grid.columns + column);
@@ -109,6 +111,21 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
 }
 
 StepStatus CurtainScene::stepFrame() {
+  scriptFrame();
+  return m_world->step(kFrameDt);
+}
+
+StepStatus CurtainScene::stepFrame(const StepBudget& budget) {
+  scriptFrame();
+  return m_world->step(kFrameDt, budget);
+}
+
+StepStatus CurtainScene::stepFrame(const StepPlan& plan) {
+  scriptFrame();
+  return m_world->step(kFrameDt, plan);
+}
+
+void CurtainScene::scriptFrame() {
   if (m_pinScript) {
     const Real endTime = (m_frame + 1) * kFrameDt;
     for (std::size_t k = 0; k < m_pinRest.size(); ++k) m_targets[k] = pinTarget(m_pinRest[k], endTime);
@@ -123,7 +140,6 @@ StepStatus CurtainScene::stepFrame() {
     (void)m_world->setColliderMotion(m_sphere, sphereMotion);
   }
   ++m_frame;
-  return m_world->step(kFrameDt);
 }
 
 }  // namespace weft

@@ -9,8 +9,10 @@
 
 #include <weft/engine/ClothModel.h>
 #include <weft/engine/FabricPresets.h>
+#include <weft/engine/FixedStepAccumulator.h>
 #include <weft/engine/Material.h>
 #include <weft/engine/RenderView.h>
 #include <weft/engine/SolverSettings.h>
+#include <weft/engine/StepBudget.h>
 #include <weft/engine/StepStats.h>
 #include <weft/engine/World.h>

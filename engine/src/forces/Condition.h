@@ -112,7 +112,7 @@ void accumulateConditionForces(const Condition<N>& condition, Real stiffness, Re
 
   const typename Condition<N>::Hessian outer = gradient * gradient.transpose();
   out.positionJacobian.noalias() -= stiffness * outer;
-  out.velocityJacobian.noalias() -= damping * outer;
+  if (damping != 0) out.velocityJacobian.noalias() -= damping * outer;  // exact: 0·outer adds +0
 
   if (mode == StiffnessMode::Exact) {
     // −k C ∇²C − k_d Ċ ∇²C share the Hessian; the last term is ∂Ċ/∂x = ∇²C v along ∇C.

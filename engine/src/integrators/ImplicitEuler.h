@@ -31,6 +31,10 @@ class ImplicitEuler final : public Integrator {
   void step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
             IntegratorReport& report) override;
   void reset() override;
+  void setSolveLimits(Real tolerance, int maxIterations) override {
+    m_settings.cgTolerance = tolerance;
+    m_settings.cgMaxIterations = maxIterations;
+  }
   void saveCarriedState(Vec3Array& out) const override;
   void restoreCarriedState(const Vec3Array& in) override;
 

@@ -39,6 +39,9 @@ class Integrator {
   /// Advances (x, v) from time t to t + h. Allocates scratch on the first call for a size only.
   virtual void step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
                     IntegratorReport& report) = 0;
+  /// Sets the linear solver's relative tolerance and iteration cap for the following steps (a
+  /// frame budget's plan); methods without a linear solve ignore it.
+  virtual void setSolveLimits(Real tolerance, int maxIterations) { (void)tolerance, (void)maxIterations; }
   /// Forgets warm-start data (after a teleport or a restore).
   virtual void reset() {}
   /// State carried from one step to the next that changes results (the implicit method's Δv

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <weft/Math.h>
+#include <weft/engine/StepBudget.h>
 
 #include <cstdint>
 #include <string>
@@ -25,6 +26,10 @@ enum class StepStatus : std::uint32_t {
   /// A frame went non-finite or diverged and was redone with more substeps (up to 8×); see
   /// StepStats::substeps. Lower the stiffness or the frame length if it keeps happening.
   RetriedWithSmallerStep = 1u << 4,
+  /// step() took longer than StepBudget::milliseconds. The plan it ran is in StepStats::plan;
+  /// the next frames' plans adapt (looser PCG tolerance, fewer iterations, fewer implicit
+  /// substeps) within the limits of StepBudget. Raise the budget or those limits if it persists.
+  BudgetMissed = 1u << 5,
 };
 
 constexpr StepStatus operator|(StepStatus a, StepStatus b) {
@@ -59,6 +64,30 @@ struct StepStats {
   Index selfContacts = 0;      ///< self-proximity pairs repelled (all substeps)
   Index selfImpacts = 0;       ///< swept self-collisions resolved by impulses (all substeps)
   Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
+  /// Vertices the self-collision last resort held at their step start because impulses and
+  /// impact zones did not clear their contacts (all substeps): the contacts the engine did not
+  /// resolve physically. They never cross; they stop instead.
+  Index frozenVertices = 0;
+
+  // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
+  Real budgetMs = 0;           ///< ms, the budget this frame was given (0 = none)
+  /// What this frame ran: substeps, PCG tolerance and iteration cap. Feeding it back through
+  /// World::step(frameDt, plan) from the same state reproduces the frame bit for bit.
+  StepPlan plan;
+
+  // Stages a scene did not need (WorldSettings::skipUnneededStages), summed over cloths and
+  // substeps. Each pair counts the times the stage ran and the times it was skipped.
+  Index colliderNarrowPhases = 0;  ///< cloth–collider pairs tested (constraint and response passes)
+  Index colliderNarrowPhasesSkipped = 0;  ///< pairs skipped: the collider's box is not near the cloth's
+  Index selfCollisionPasses = 0;   ///< self-collision passes run (BVH refit, queries, response)
+  /// Passes skipped because the cloth provably cannot touch itself in that substep (FoldCulling:
+  /// no fold, and features farther apart than the thickness plus twice the step's motion). A
+  /// cloth with ClothSettings::selfCollision off counts neither run nor skipped passes.
+  Index selfCollisionSkipped = 0;
+  Index bendingAssemblies = 0;     ///< force evaluations that included the bending hinges
+  Index dampingJacobians = 0;      ///< assemblies that formed damping (∂f/∂v) Jacobians
+  Index sleepingCloths = 0;        ///< cloths asleep during this frame (not stepped)
+  Index wokenCloths = 0;           ///< cloths that woke at the start of this frame
   StepStatus status = StepStatus::Ok;  ///< the flags step() returned
 };
 

@@ -17,6 +17,7 @@
 #include <weft/engine/Material.h>
 #include <weft/engine/RenderView.h>
 #include <weft/engine/SolverSettings.h>
+#include <weft/engine/StepBudget.h>
 #include <weft/engine/StepStats.h>
 #include <weft/threading/TaskSystem.h>
 
@@ -28,6 +29,7 @@
 namespace weft {
 
 struct ColliderFrame;  // internal: a collider as one step sees it
+class FrameCostModel;  // internal: the budget planner
 
 /// Handle to a cloth in a World. Zero-initialised = null.
 struct ClothId {
@@ -52,6 +54,21 @@ struct ColliderSettings {
   Real friction = 0.3;
 };
 
+/// When a cloth at rest stops being simulated. A sleeping cloth costs nothing per frame and
+/// keeps its positions (its velocities are zero); it wakes when one of its pins is given a new
+/// target, when a collider near it moves, appears or disappears, when gravity or wind change,
+/// on setState() and on World::wake(). A cloth sleeps only near equilibrium: both its speed and
+/// the acceleration of its last frame must stay small, so a cloth that happens to be still while
+/// forces pull on it (released from rest, at the top of a swing) keeps moving.
+struct SleepSettings {
+  bool enabled = true;      ///< allow this cloth to sleep
+  Real speed = 2e-3;        ///< m/s, every vertex slower than this...
+  /// m/s², ...and no vertex's velocity changed faster than this over the frame (the residual of
+  /// M a = f: zero at equilibrium, g for a cloth released from rest)...
+  Real acceleration = 0.05;
+  Index frames = 30;        ///< ...for this many consecutive frames
+};
+
 /// Per-instance settings of a cloth.
 struct ClothSettings {
   ForceModel forceModel = ForceModel::BaraffWitkin;  ///< continuum (default) or springs
@@ -64,6 +81,7 @@ struct ClothSettings {
   /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
+  SleepSettings sleep;  ///< when the cloth at rest stops being simulated
 };
 
 /// A snapshot of a World: time, every cloth's positions, velocities, pin targets and solver warm
@@ -95,6 +113,12 @@ struct WorldSettings {
   /// The caller's own task system (and so its oneTBB arena), which must outlive the world. Null:
   /// the world makes one with threadCount threads. Nothing else spawns threads.
   TaskSystem* taskSystem = nullptr;
+  /// Skip the stages a scene does not need: the narrow phase against colliders whose box is not
+  /// near the cloth, self-collision for a cloth that cannot fold onto itself, bending and damping
+  /// terms whose coefficients are zero. The skips are exact (same bits) except the self-collision
+  /// cull, which is conservative by a stated margin (see FoldCulling). Off: every stage runs
+  /// every substep, for checking that the skips change nothing. Sleeping is ClothSettings::sleep.
+  bool skipUnneededStages = true;
 };
 
 class World {
@@ -140,10 +164,12 @@ class World {
 
   /// N, a force on each vertex of the cloth (one per vertex, in vertex order), applied every
   /// substep until changed; an empty span removes them. Pinned vertices ignore it. Game forces
-  /// such as a blast, a hand pulling or a scripted gust go here. On error nothing changes.
+  /// such as a blast, a hand pulling or a scripted gust go here. Wakes the cloth. On error
+  /// nothing changes.
   Status setExternalForces(ClothId cloth, std::span<const Vec3> forces);
   /// m/s, the air velocity every cloth feels through ClothMaterial::airDrag from the next step
-  /// on (WorldSettings::wind at creation). Must be finite; on error nothing changes.
+  /// on (WorldSettings::wind at creation); wakes every cloth. Must be finite; on error nothing
+  /// changes.
   Status setWind(const Vec3& wind);
   /// m/s, the current air velocity.
   const Vec3& wind() const { return m_settings.wind; }
@@ -152,12 +178,30 @@ class World {
   /// to teleport it. Pinned vertices jump with it and their targets are set to the new positions.
   /// Sizes must match the vertex count and every value must be finite; on error nothing changes.
   Status setState(ClothId cloth, std::span<const Vec3> positions, std::span<const Vec3> velocities);
+  /// Changes gravity (m/s²) for every cloth and wakes them all. Finite values only.
+  Status setGravity(const Vec3& gravity);
+  /// Wakes a sleeping cloth (no effect on an awake one).
+  Status wake(ClothId cloth);
+  /// True while the cloth sleeps (see SleepSettings).
+  Result<bool> isSleeping(ClothId cloth) const;
   /// Current pin targets (the ones the next frame ends at).
   Result<std::vector<Vec3>> pinTargets(ClothId cloth) const;
 
   /// Advances every cloth by frameDt seconds (> 0, finite). Returns the status flags, also kept
   /// in stats().status.
   StepStatus step(Real frameDt);
+  /// Advances by frameDt within a wall-clock budget: the substeps, PCG tolerance and iteration
+  /// cap are planned from the measured cost of earlier frames (see StepBudget). A frame that
+  /// still overruns is reported (StepStatus::BudgetMissed), never hidden; the plan it ran and
+  /// the accuracy it reached (cgResidual, maxStrain, frozenVertices) are in stats().
+  /// budget.milliseconds = 0 is the same as step(frameDt). Invalid budget fields are refused
+  /// (StepStatus::InvalidInput) and nothing changes.
+  StepStatus step(Real frameDt, const StepBudget& budget);
+  /// Advances by frameDt running exactly `plan` (e.g. a StepStats::plan recorded by a budgeted
+  /// run): the same plan from the same state gives the same bits. Invalid plan fields (negative
+  /// or non-finite, a tolerance of 1 or more, more substeps than any cloth's
+  /// SolverSettings::maxSubsteps) are refused with StepStatus::InvalidInput and nothing changes.
+  StepStatus step(Real frameDt, const StepPlan& plan);
   /// Statistics of the last step().
   const StepStats& stats() const { return m_stats; }
   /// s, simulated time.
@@ -205,6 +249,11 @@ class World {
   std::vector<ColliderFrame> m_colliderFrames;  // scratch for step()
   std::vector<RigidMotion> m_colliderStartMotions;  // scratch for step()
   std::vector<Vec3> m_attachedTargets;              // scratch for step()
+  // Runs one frame with `plan`; budgetMs > 0 reports a miss; the cost model is refitted from the
+  // frame's timings (weight costSmoothing) assuming `defaultTolerance` where the plan has none.
+  StepStatus stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs, Real costSmoothing,
+                          Real defaultTolerance = 1e-3);
+  std::unique_ptr<FrameCostModel> m_costModel;  // fitted to measured frames (budgeted steps)
   StepStats m_stats;
   Real m_time = 0;
 };

@@ -32,6 +32,8 @@ struct CurtainSettings {
   bool selfCollision = true; ///< keep the curtain from passing through itself
   int threadCount = 0;                ///< threads of the scene's world (0 = all cores, 1 = serial)
   TaskSystem* taskSystem = nullptr;   ///< or the caller's task system (overrides threadCount)
+  bool skipUnneededStages = true;     ///< WorldSettings::skipUnneededStages
+  bool sleep = true;                  ///< ClothSettings::sleep.enabled
 };
 
 /// The curtain scene: a World with one cloth and the pin script.
@@ -46,6 +48,10 @@ class CurtainScene {
 
   /// Moves the rod to where the script puts it at the end of the next frame, then steps.
   StepStatus stepFrame();
+  /// The same, within a frame budget (World::step(frameDt, budget)).
+  StepStatus stepFrame(const StepBudget& budget);
+  /// The same, running a given plan (World::step(frameDt, plan)), e.g. to replay a budgeted run.
+  StepStatus stepFrame(const StepPlan& plan);
 
   World& world() { return *m_world; }
   const World& world() const { return *m_world; }
@@ -71,6 +77,7 @@ class CurtainScene {
 
  private:
   CurtainScene() = default;
+  void scriptFrame();  // sets the rod and sphere for the coming frame
 
   std::unique_ptr<World> m_world;
   std::shared_ptr<const ClothModel> m_model;
