@@ -45,7 +45,7 @@ struct BulletCurtain::Bullet {
 
   std::vector<int> pinnedNodes;
   Vec3Array pinRest;
-  double time = 0;  // s, simulated time at the start of the next Bullet step
+  long stepsTaken = 0;  // Bullet steps so far; the script's clock, kept in double
   int substeps = 1;
   bool selfCollision = false;
 
@@ -59,7 +59,7 @@ struct BulletCurtain::Bullet {
 
   // Called by Bullet at the start of each of its steps (pre-tick callback).
   void beforeStep(double stepDt) {
-    const double endTime = time + stepDt;
+    const double endTime = double(++stepsTaken) * CurtainScene::kFrameDt / substeps;
     for (std::size_t k = 0; k < pinnedNodes.size(); ++k) {
       btSoftBody::Node& node = cloth->m_nodes[pinnedNodes[k]];
       const btVector3 target = toBullet(CurtainScene::pinTarget(pinRest[k], endTime));
@@ -74,7 +74,6 @@ struct BulletCurtain::Bullet {
     sphere->setWorldTransform(pose);
     sphere->setLinearVelocity((end - start) / btScalar(stepDt));
     sphere->setInterpolationLinearVelocity((end - start) / btScalar(stepDt));
-    time = endTime;
   }
 
   static void preTick(btDynamicsWorld* world, btScalar stepDt) {
@@ -111,8 +110,8 @@ Result<std::unique_ptr<BulletCurtain>> BulletCurtain::create(const BulletCurtain
       !(settings.bendingStiffnessPerFrame >= 0 && settings.bendingStiffnessPerFrame < 1)) {
     return Error{"Bullet curtain: stretchStiffness must lie in (0, 1] and bendingStiffnessPerFrame in [0, 1)"};
   }
-  if (!(settings.collisionMargin > 0) || !(settings.sdfVoxelSize > 0) || !(settings.dampingRate >= 0)) {
-    return Error{"Bullet curtain: collisionMargin and sdfVoxelSize must be positive, dampingRate not negative"};
+  if (!(settings.collisionMargin >= 0) || !(settings.sdfVoxelSize > 0) || !(settings.dampingRate >= 0)) {
+    return Error{"Bullet curtain: collisionMargin must not be negative, sdfVoxelSize must be positive, dampingRate not negative"};
   }
   std::unique_ptr<BulletCurtain> curtain(new BulletCurtain());
   Bullet& bullet = *curtain->m_bullet;
@@ -172,7 +171,9 @@ Result<std::unique_ptr<BulletCurtain>> BulletCurtain::create(const BulletCurtain
   config.kCHR = 1;  // rigid contacts fully resolved
   config.kKHR = 1;  // the sphere is kinematic: Bullet's default 0.1 lets it sink into the cloth
   config.collisions = btSoftBody::fCollision::SDF_RS;
-  cloth->getCollisionShape()->setMargin(btScalar(settings.collisionMargin));
+  const double gridSpacing = 2.0 / (columns - 1);
+  const double margin = settings.collisionMargin > 0 ? settings.collisionMargin : gridSpacing / 5;
+  cloth->getCollisionShape()->setMargin(btScalar(margin));
 
   // The ±5 mm pleats Weft starts with (CurtainSettings::initialWaviness), after the rest lengths
   // were taken from the flat patch.
