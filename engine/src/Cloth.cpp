@@ -426,6 +426,7 @@ bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<Collider
     report.integrator.potentialEnergy = substepReport.potentialEnergy;
     report.integrator.assemblyMs += substepReport.assemblyMs;
     report.integrator.solveMs += substepReport.solveMs;
+    report.integrator.releasedContacts += substepReport.releasedContacts;
     // A cheap health check each substep: a NaN spreads through the whole mesh within one solve,
     // and a diverging explicit method passes any physical speed within a few substeps.
     WEFT_PROFILE_ZONE("health");

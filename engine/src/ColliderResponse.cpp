@@ -97,13 +97,22 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
         if (queryPoint(shape, carriedStart).distance < thickness) continue;  // started in contact: projection handles it
         const Real s = sweptContact(shape, carriedStart, x[i], thickness);
         if (s < 0) continue;
-        // The vertex met the surface at s and then rides along with the body.
-        x[i] = carriedStart + s * (x[i] - carriedStart);
+        // The vertex met the surface at s. For the rest of the step it keeps its motion relative
+        // to the body except the part into the surface (inelastic): it slides on. Carrying it
+        // with the body instead would glue a vertex that merely brushed a collider to it, and a
+        // collider sliding past the cloth would drag it along.
+        const Vec3 relativeTravel = x[i] - carriedStart;
+        const Vec3 hit = carriedStart + s * relativeTravel;
+        const Vec3 hitNormal = queryPoint(shape, hit).normal;
+        Vec3 remaining = (1 - s) * relativeTravel;
+        const Real inward = remaining.dot(hitNormal);
+        if (inward < 0) remaining -= inward * hitNormal;
+        x[i] = hit + remaining;
         contact = queryPoint(shape, x[i]);
         ++report.sweptHits;
       }
-      // Onto the surface plus thickness.
-      x[i] += (thickness - contact.distance) * contact.normal;
+      // Onto the surface plus thickness (a vertex that slid clear of it stays where it is).
+      if (contact.distance < thickness) x[i] += (thickness - contact.distance) * contact.normal;
       // Inelastic: no relative velocity into the surface.
       const Vec3 relative = v[i] - contact.velocity;
       const Real normalSpeed = relative.dot(contact.normal);

@@ -1,0 +1,168 @@
+// A collider contact may only push: a sphere that pushes into a hanging sheet and then
+// withdraws faster than the sheet falls back must leave it behind, not drag it along
+// (Baraff & Witkin 1998 §5.3 release the constraints whose force turns adhesive).
+#include "integrators/Integrator.h"
+#include "solver/BlockSparseMatrix.h"
+#include "solver/VertexFilter.h"
+
+#include <weft/collision/Plane.h>
+#include <weft/collision/Sphere.h>
+#include <weft/engine/World.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+
+namespace weft {
+namespace {
+
+// One particle resting on a floor (normal +y), held by a spring towards an anchor above or
+// below it. The contact constrains its normal velocity change to zero, as Cloth does for a
+// vertex predicted to end within the thickness.
+class ParticleOnFloor final : public DynamicSystem {
+ public:
+  explicit ParticleOnFloor(Real anchorHeight)
+      : m_anchor(0.0, anchorHeight, 0.0), m_matrix(1, std::span<const std::array<Index, 2>>()) {}
+  Index vertexCount() const override { return 1; }
+  const std::vector<Real>& masses() const override { return m_masses; }
+  Real computeForces(const Vec3Array& x, const Vec3Array&, Real, Vec3Array& f) override {
+    f.resize(1);
+    f[0] = -kStiffness * (x[0] - m_anchor);
+    return 0.5 * kStiffness * (x[0] - m_anchor).squaredNorm();
+  }
+  Real linearize(const Vec3Array& x, const Vec3Array& v, Real t, Real h, Vec3Array& f,
+                 const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) override {
+    const Real energy = computeForces(x, v, t, f);
+    m_matrix.block(m_matrix.diagonalSlot(0)) = (m_masses[0] + h * h * kStiffness) * Mat3::Identity();
+    stiffnessTimesVelocity.resize(1);
+    stiffnessTimesVelocity[0] = -kStiffness * velocityForProduct[0];
+    return energy;
+  }
+  const BlockSparseMatrix& systemMatrix() const override { return m_matrix; }
+  std::span<const Index> prescribedVertices() const override { return {}; }
+  void applyPrescribedMotion(Real, Vec3Array&, Vec3Array&) const override {}
+  void constrainContacts(const Vec3Array&, const Vec3Array&, Real, VertexFilter& filter) override {
+    filter.setConstrained(0, Vec3::UnitY(), Vec3::Zero());
+  }
+
+ private:
+  static constexpr Real kStiffness = 10.0;  // N/m
+  std::vector<Real> m_masses{0.01};         // kg
+  Vec3 m_anchor;
+  BlockSparseMatrix m_matrix;
+};
+
+TEST(ContactRelease, AContactThatWouldPullIsReleasedAndOneThatPushesIsKept) {
+  for (const Real anchorHeight : {+1.0, -1.0}) {
+    ParticleOnFloor system(anchorHeight);
+    std::unique_ptr<Integrator> integrator =
+        Integrator::create(IntegratorKind::ImplicitEuler, SolverSettings{});
+    Vec3Array x{Vec3::Zero()}, v{Vec3::Zero()};
+    IntegratorReport report;
+    integrator->step(system, x, v, 0.0, 1.0 / 60.0, report);
+    if (anchorHeight > 0) {
+      // Pulled up: holding it on the floor would take a pull from the floor. Released, it rises.
+      EXPECT_EQ(report.releasedContacts, 1u);
+      EXPECT_GT(v[0].y(), 0.0);
+    } else {
+      // Pressed down: the floor pushes back and the contact holds it exactly.
+      EXPECT_EQ(report.releasedContacts, 0u);
+      EXPECT_EQ(v[0].y(), 0.0);
+    }
+  }
+}
+
+struct SheetAndSphere {
+  std::unique_ptr<World> world;
+  ClothId cloth;
+  ColliderId sphere;
+};
+
+// A 1 m × 0.75 m sheet pinned along its top, and a sphere that comes from behind (−z) and has
+// pushed the sheet 0.2 m forward after 45 frames.
+SheetAndSphere pushedSheet() {
+  constexpr Index kColumns = 21, kRows = 16;
+  GridSettings grid;
+  grid.columns = kColumns;
+  grid.rows = kRows;
+  grid.width = 1.0;
+  grid.height = 0.75;
+  grid.origin = {-0.5, 0.5, 0.0};
+  auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  ClothSettings settings;
+  for (Index c = 0; c < kColumns; ++c) settings.pinnedVertices.push_back((kRows - 1) * kColumns + c);
+  SheetAndSphere scene;
+  scene.world = std::make_unique<World>(WorldSettings{.threadCount = 1});
+  scene.cloth = scene.world->createCloth(model, settings).value();
+  RigidMotion motion;
+  motion.pose.position = {0.0, 0.85, -0.35};
+  motion.linearVelocity = {0.0, 0.0, 0.8};
+  scene.sphere = scene.world->addCollider(Sphere::create(0.15, motion).value()).value();
+  for (int k = 0; k < 45; ++k) scene.world->step(1.0 / 60.0);  // centre reaches z = +0.25
+  return scene;
+}
+
+TEST(ContactRelease, AWithdrawingSphereLeavesTheSheetAsIfItHadVanished) {
+  // Twin runs from the same pushed state: in one the sphere pulls back at 4 m/s, far faster
+  // than the sheet swings back; in the other it simply disappears. A contact that may only
+  // push cannot hold the sheet, so both sheets must swing back alike. One that may pull drags
+  // the sheet back with the sphere.
+  SheetAndSphere withdrawn = pushedSheet();
+  SheetAndSphere vanished = pushedSheet();
+  Real pushed = 0;
+  for (const Vec3& x : withdrawn.world->positions(withdrawn.cloth).value()) {
+    pushed = std::max(pushed, x.z());
+  }
+  ASSERT_GT(pushed, 0.1) << "the sphere should have pushed the sheet forward";
+
+  RigidMotion motion = weft::motion(*withdrawn.world->collider(withdrawn.sphere).value());
+  motion.linearVelocity = {0.0, 0.0, -4.0};
+  ASSERT_TRUE(withdrawn.world->setColliderMotion(withdrawn.sphere, motion).ok());
+  ASSERT_TRUE(vanished.world->destroyCollider(vanished.sphere).ok());
+  Real largestGap = 0;
+  for (int k = 0; k < 20; ++k) {
+    withdrawn.world->step(1.0 / 60.0);
+    vanished.world->step(1.0 / 60.0);
+    const std::span<const Vec3> a = withdrawn.world->positions(withdrawn.cloth).value();
+    const std::span<const Vec3> b = vanished.world->positions(vanished.cloth).value();
+    for (std::size_t i = 0; i < a.size(); ++i) largestGap = std::max(largestGap, (a[i] - b[i]).norm());
+  }
+  EXPECT_LT(largestGap, 0.01) << "m: the withdrawing sphere dragged the sheet";
+}
+
+TEST(ContactRelease, ClothLyingOnTheFloorLiftsOffWhenPulledUp) {
+  // A sheet lying on the floor, one edge pinned and yanked up 1.5 m in half a second: floor
+  // contacts must let go of the rows the edge pulls up instead of holding them down and
+  // stretching the edge between them.
+  constexpr Index kColumns = 11, kRows = 11;
+  GridSettings grid;
+  grid.columns = kColumns;
+  grid.rows = kRows;
+  grid.width = 0.5;
+  grid.height = 0.5;
+  grid.origin = {-0.25, ClothMaterial{}.thickness, -0.25};  // resting on the floor
+  grid.widthAxis = {1.0, 0.0, 0.0};
+  grid.heightAxis = {0.0, 0.0, 1.0};
+  auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  ClothSettings settings;
+  for (Index c = 0; c < kColumns; ++c) settings.pinnedVertices.push_back((kRows - 1) * kColumns + c);
+  World world(WorldSettings{.threadCount = 1});
+  ASSERT_TRUE(world.addCollider(Plane::create({0.0, 1.0, 0.0}).value()).ok());
+  const ClothId cloth = world.createCloth(model, settings).value();
+  // Let gravity press it onto the floor first.
+  for (int k = 0; k < 30; ++k) world.step(1.0 / 60.0);
+  std::vector<Vec3> targets = world.pinTargets(cloth).value();
+  for (int k = 0; k < 30; ++k) {
+    for (Vec3& target : targets) target.y() += 0.05;
+    ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
+    world.step(1.0 / 60.0);
+  }
+  const std::span<const Vec3> x = world.positions(cloth).value();
+  // The row next to the lifted one hangs below it by about one spacing, not on the floor.
+  const Index nextRow = (kRows - 2) * kColumns + kColumns / 2;
+  EXPECT_GT(x[nextRow].y(), 1.5 - 2 * 0.05);
+  EXPECT_LT(world.stats().maxStrain, 0.1);
+}
+
+}  // namespace
+}  // namespace weft
