@@ -296,7 +296,7 @@ bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<Collider
     if (m_selfCollision) {
       const SelfCollisionReport self = m_selfCollision->resolve(
           m_stepStartPositions, h, m_settings.material.thickness, m_settings.material.friction,
-          m_inverseMasses, m_positions, m_velocities);
+          m_inverseMasses, m_positions, m_velocities, colliders);
       report.selfCollision.proximityContacts += self.proximityContacts;
       report.selfCollision.impacts += self.impacts;
       report.selfCollision.impactZones += self.impactZones;

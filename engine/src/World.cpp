@@ -1,6 +1,7 @@
 #include <weft/engine/World.h>
 
 #include "Cloth.h"
+#include "ClothClothCollision.h"
 
 #include <weft/threading/Profiler.h>
 
@@ -62,6 +63,7 @@ World::World(const WorldSettings& settings) : m_settings(settings) {
     m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{std::max(0, settings.threadCount)});
     m_tasks = m_ownedTasks.get();
   }
+  m_clothContact = std::make_unique<ClothClothCollision>(m_tasks);
 }
 
 int World::threadCount() const { return m_tasks->threadCount(); }
@@ -240,12 +242,38 @@ StepStatus World::step(Real frameDt) {
     if (!collider->shape) continue;
     (void)setMotion(*collider->shape, advanceMotion(m_colliderStartMotions[k++], frameDt));
   }
+  collideCloths(frameDt, stats);
   m_time += frameDt;
   stats.simulatedTime = m_time;
   stats.stepMs =
       std::chrono::duration<Real, std::milli>(std::chrono::steady_clock::now() - start).count();
   m_stats = stats;
   return stats.status;
+}
+
+void World::collideCloths(Real frameDt, StepStats& stats) {
+  m_clothContact->beginFrame();
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    const ClothSlot& slot = *m_slots[k];
+    if (!slot.cloth || !slot.cloth->settings().collideWithOtherCloths) continue;
+    m_clothContact->addCloth(ClothId{std::uint32_t(k + 1), slot.generation}, slot.cloth.get());
+  }
+  // The colliders over the whole frame: from their start motions to where they are now.
+  m_colliderFrames.clear();
+  std::size_t k = 0;
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (!collider->shape) continue;
+    ColliderFrame frame;
+    frame.shape = &*collider->shape;
+    frame.start = m_colliderStartMotions[k++];
+    frame.end = motion(*collider->shape);
+    frame.friction = collider->settings.friction;
+    m_colliderFrames.push_back(frame);
+  }
+  const SelfCollisionReport report = m_clothContact->resolveFrame(frameDt, m_colliderFrames);
+  stats.clothContacts += report.proximityContacts;
+  stats.clothImpacts += report.impacts;
+  stats.clothImpactZones += report.impactZones;
 }
 
 Result<ClothRenderView> World::renderView(ClothId id) const {

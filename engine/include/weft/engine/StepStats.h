@@ -60,6 +60,9 @@ struct StepStats {
   Index selfImpacts = 0;       ///< swept self-collisions resolved by impulses (all substeps)
   Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
   StepStatus status = StepStatus::Ok;  ///< the flags step() returned
+  Index clothContacts = 0;     ///< proximity pairs between different cloths repelled
+  Index clothImpacts = 0;      ///< swept collisions resolved at the frame's cloth–cloth pass
+  Index clothImpactZones = 0;  ///< impact-zone passes of the cloth–cloth pass (fail-safe)
 };
 
 }  // namespace weft

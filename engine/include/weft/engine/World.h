@@ -28,6 +28,7 @@
 namespace weft {
 
 struct ColliderFrame;  // internal: a collider as one step sees it
+class ClothClothCollision;  // internal: contact between cloths
 
 /// Handle to a cloth in a World. Zero-initialised = null.
 struct ClothId {
@@ -64,6 +65,10 @@ struct ClothSettings {
   /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
+  /// Keeps the cloth from passing through other cloths of the world that have this switch on
+  /// too (contact resolved once per frame, after every cloth has stepped). Costs a bounds test
+  /// per frame while the cloths are apart.
+  bool collideWithOtherCloths = true;
 };
 
 /// A snapshot of a World: time, every cloth's positions, velocities, pin targets and solver warm
@@ -182,6 +187,10 @@ class World {
   std::vector<RigidMotion> m_colliderStartMotions;  // scratch for step()
   StepStats m_stats;
   Real m_time = 0;
+
+  // Contact between cloths, after every cloth has stepped the frame (ClothClothCollision.h).
+  void collideCloths(Real frameDt, StepStats& stats);
+  std::unique_ptr<ClothClothCollision> m_clothContact;
 };
 
 }  // namespace weft
