@@ -216,13 +216,11 @@ SelfCollisionReport ClothClothCollision::resolveFrame(Real frameDt,
   options.proximity = false;
   for (int round = 0; changed && !colliders.empty() && round < kColliderRounds; ++round) {
     if (!resolveColliders(colliders)) break;
-    if (getenv("DBG")) printf("  round %d\n", round);
     const SelfCollisionReport again = resolve(m_start, frameDt, m_owners, m_inverseMasses, options, m_x, m_v);
     report.impacts += again.impacts;
     report.impactZones += again.impactZones;
     report.frozenVertices += again.frozenVertices;
     changed = writeBack();
-    if (getenv("DBG")) printf("  round %d: changed %d impacts %u zones %u frozen %u\n", round, changed, again.impacts, again.impactZones, again.frozenVertices);
   }
   setColliders({});
   return report;

@@ -2,6 +2,7 @@
 
 #include <weft/collision/ContinuousCollision.h>
 #include <weft/collision/Proximity.h>
+#include <weft/threading/GrainSizes.h>
 #include <weft/threading/Profiler.h>
 
 #include <Eigen/Dense>
@@ -26,6 +27,9 @@ constexpr Real kImpactSeparation = 0.25;
 // hundred, so 128 pairs are ~5–40 µs of work, above a fork/join (GrainSizes.h); the curtain's
 // few thousand pairs still make tens of blocks.
 constexpr TaskSystem::Index kGrainFeaturePairs = 128;
+// Candidate triangle pairs per parallel block when collecting feature pairs: a few box tests
+// each, ~50–100 ns, so 256 pairs are ~15–25 µs.
+constexpr TaskSystem::Index kGrainTrianglePairs = 256;
 
 // A vertex that ends within this many thicknesses of a collider is held by it (the collider
 // response leaves its contacts at exactly one thickness).
@@ -63,6 +67,25 @@ void ContactResolver::setTopology(std::vector<std::array<Index, 3>> triangles,
   m_rest = std::move(rest);
   m_owner = std::move(owners);
   m_zoneParent.resize(m_rest.size());
+  // Triangles around every vertex (ascending) and the one or two triangles of every edge.
+  const Index vertexCount = Index(m_rest.size());
+  m_vertexTriangleBegin.assign(vertexCount + 1, 0);
+  for (const auto& triangle : m_triangles) {
+    for (Index vertex : triangle) ++m_vertexTriangleBegin[vertex + 1];
+  }
+  for (Index i = 0; i < vertexCount; ++i) m_vertexTriangleBegin[i + 1] += m_vertexTriangleBegin[i];
+  m_vertexTriangles.resize(m_vertexTriangleBegin[vertexCount]);
+  std::vector<Index> fill(m_vertexTriangleBegin.begin(), m_vertexTriangleBegin.end() - 1);
+  for (Index t = 0; t < m_triangles.size(); ++t) {
+    for (Index vertex : m_triangles[t]) m_vertexTriangles[fill[vertex]++] = t;
+  }
+  m_edgeTriangles.assign(m_edges.size(), {kInvalidIndex, kInvalidIndex});
+  for (Index t = 0; t < m_triangleEdges.size(); ++t) {
+    for (Index edge : m_triangleEdges[t]) {
+      std::array<Index, 2>& slots = m_edgeTriangles[edge];
+      (slots[0] == kInvalidIndex ? slots[0] : slots[1]) = t;
+    }
+  }
 }
 
 void ContactResolver::pairParameters(Index first, Index second, Real& thickness,
@@ -79,49 +102,120 @@ void ContactResolver::pairParameters(Index first, Index second, Real& thickness,
   }
 }
 
+bool ContactResolver::sharesVertex(Index first, Index second) const {
+  const std::array<Index, 3>& a = m_triangles[first];
+  const std::array<Index, 3>& b = m_triangles[second];
+  for (Index i : a) {
+    if (i == b[0] || i == b[1] || i == b[2]) return true;
+  }
+  return false;
+}
+
 void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin) {
-  m_vertexTriangle.clear();
-  m_edgeEdge.clear();
-  auto box = [&](std::initializer_list<Index> vertices, Real inflate) {
-    Aabb bounds = Aabb::empty();
-    for (Index vertex : vertices) {
-      bounds.expand(from[vertex]);
-      bounds.expand(to[vertex]);
-    }
-    bounds.inflate(inflate);
-    return bounds;
+  WEFT_PROFILE_ZONE("feature pairs");
+  // Every vertex's box over the step, once, instead of once per triangle pair it is in.
+  const Index vertexCount = Index(from.size());
+  m_vertexBoxes.resize(vertexCount);
+  auto boxVertices = [&](Index begin, Index end, int) {
+    for (Index i = begin; i < end; ++i) m_vertexBoxes[i] = Aabb::fromCorners(from[i], to[i]);
   };
-  // Most candidate triangle pairs are neighbours whose inflated boxes just touch; testing the
-  // features' own boxes first keeps the exact tests (and the sort below) to the few that matter.
-  for (const TrianglePair& pair : m_trianglePairs) {
-    const std::array<Index, 3>& first = m_triangles[pair.first];
-    const std::array<Index, 3>& second = m_triangles[pair.second];
-    const Aabb firstBox = box({first[0], first[1], first[2]}, 0);
-    const Aabb secondBox = box({second[0], second[1], second[2]}, 0);
-    for (Index vertex : first) {
-      if (box({vertex}, margin).overlaps(secondBox)) m_vertexTriangle.push_back({vertex, pair.second});
+  if (m_tasks) {
+    m_tasks->parallelFor(vertexCount, kGrainVertices, boxVertices);
+  } else {
+    boxVertices(0, vertexCount, 0);
+  }
+  auto triangleBox = [&](Index triangle) {
+    const std::array<Index, 3>& c = m_triangles[triangle];
+    Aabb box = m_vertexBoxes[c[0]];
+    box.expand(m_vertexBoxes[c[1]]);
+    box.expand(m_vertexBoxes[c[2]]);
+    return box;
+  };
+  auto edgeBox = [&](Index edge) {
+    Aabb box = m_vertexBoxes[m_edges[edge][0]];
+    box.expand(m_vertexBoxes[m_edges[edge][1]]);
+    return box;
+  };
+  // A feature pair is reached through several triangle pairs; it is taken from one of them
+  // only, its canonical pair, so no sort is needed to remove the others and the features come
+  // out in the (sorted) order of the triangle pairs. Vertex v against triangle B: from the
+  // lowest-numbered triangle around v that shares no vertex with B. Edge a against edge b: from
+  // the lowest (lo, hi) of their triangles that share no vertex. The broad phase reports that
+  // pair whenever it reports any (its boxes hold the features' boxes; margin ≤ 2 × inflate), so
+  // nothing is lost.
+  auto vertexOwner = [&](Index vertex, Index triangle) {
+    for (Index k = m_vertexTriangleBegin[vertex]; k < m_vertexTriangleBegin[vertex + 1]; ++k) {
+      if (!sharesVertex(m_vertexTriangles[k], triangle)) return m_vertexTriangles[k];
     }
-    for (Index vertex : second) {
-      if (box({vertex}, margin).overlaps(firstBox)) m_vertexTriangle.push_back({vertex, pair.first});
+    return kInvalidIndex;
+  };
+  auto edgeOwner = [&](Index a, Index b) {
+    TrianglePair best{kInvalidIndex, kInvalidIndex};
+    for (Index ta : m_edgeTriangles[a]) {
+      for (Index tb : m_edgeTriangles[b]) {
+        if (ta == kInvalidIndex || tb == kInvalidIndex || sharesVertex(ta, tb)) continue;
+        const TrianglePair pair{std::min(ta, tb), std::max(ta, tb)};
+        if (pair < best) best = pair;
+      }
     }
-    // The broad phase reports only triangles that share no vertex, so their edges share none
-    // either.
-    for (Index a : m_triangleEdges[pair.first]) {
-      const Aabb edgeBox = box({m_edges[a][0], m_edges[a][1]}, margin);
-      if (!edgeBox.overlaps(secondBox)) continue;
-      for (Index b : m_triangleEdges[pair.second]) {
-        if (edgeBox.overlaps(box({m_edges[b][0], m_edges[b][1]}, 0))) {
-          m_edgeEdge.push_back({std::min(a, b), std::max(a, b)});
+    return best;
+  };
+  auto collect = [&](Index begin, Index end, std::vector<std::array<Index, 2>>& vertexTriangle,
+                     std::vector<std::array<Index, 2>>& edgeEdge) {
+    for (Index k = begin; k < end; ++k) {
+      const TrianglePair& pair = m_trianglePairs[k];
+      const Aabb firstBox = triangleBox(pair.first);
+      const Aabb secondBox = triangleBox(pair.second);
+      for (Index vertex : m_triangles[pair.first]) {
+        Aabb box = m_vertexBoxes[vertex];
+        box.inflate(margin);
+        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first) {
+          vertexTriangle.push_back({vertex, pair.second});
+        }
+      }
+      for (Index vertex : m_triangles[pair.second]) {
+        Aabb box = m_vertexBoxes[vertex];
+        box.inflate(margin);
+        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second) {
+          vertexTriangle.push_back({vertex, pair.first});
+        }
+      }
+      // The broad phase reports only triangles that share no vertex, so their edges share none
+      // either.
+      for (Index a : m_triangleEdges[pair.first]) {
+        Aabb first = edgeBox(a);
+        first.inflate(margin);
+        if (!first.overlaps(secondBox)) continue;
+        for (Index b : m_triangleEdges[pair.second]) {
+          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair) {
+            edgeEdge.push_back({std::min(a, b), std::max(a, b)});
+          }
         }
       }
     }
+  };
+  m_vertexTriangle.clear();
+  m_edgeEdge.clear();
+  const Index pairCount = Index(m_trianglePairs.size());
+  if (!m_tasks || m_tasks->isSerial() || pairCount <= kGrainTrianglePairs) {
+    collect(0, pairCount, m_vertexTriangle, m_edgeEdge);
+    return;
   }
-  // A feature pair reached through several triangle pairs is tested once, in a fixed order.
-  std::sort(m_vertexTriangle.begin(), m_vertexTriangle.end());
-  m_vertexTriangle.erase(std::unique(m_vertexTriangle.begin(), m_vertexTriangle.end()),
-                         m_vertexTriangle.end());
-  std::sort(m_edgeEdge.begin(), m_edgeEdge.end());
-  m_edgeEdge.erase(std::unique(m_edgeEdge.begin(), m_edgeEdge.end()), m_edgeEdge.end());
+  // In parallel over fixed blocks, each block into its own lists, joined in block order: the
+  // same lists as the serial loop.
+  const Index blocks = TaskSystem::blockCount(pairCount, kGrainTrianglePairs);
+  if (m_blockFeatures.size() < blocks) m_blockFeatures.resize(blocks);
+  m_tasks->parallelFor(pairCount, kGrainTrianglePairs, [&](Index begin, Index end, int) {
+    BlockFeatures& block = m_blockFeatures[begin / kGrainTrianglePairs];
+    block.vertexTriangle.clear();
+    block.edgeEdge.clear();
+    collect(begin, end, block.vertexTriangle, block.edgeEdge);
+  });
+  for (Index b = 0; b < blocks; ++b) {
+    const BlockFeatures& block = m_blockFeatures[b];
+    m_vertexTriangle.insert(m_vertexTriangle.end(), block.vertexTriangle.begin(), block.vertexTriangle.end());
+    m_edgeEdge.insert(m_edgeEdge.end(), block.edgeEdge.begin(), block.edgeEdge.end());
+  }
 }
 
 template <class Test>

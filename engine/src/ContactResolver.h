@@ -145,8 +145,10 @@ class ContactResolver {
   };
 
   // Vertex–triangle and edge–edge pairs of the candidate triangle pairs whose own boxes (over
-  // positions `from` and `to`, one side inflated by `margin`) overlap; sorted and unique.
+  // positions `from` and `to`, one side inflated by `margin`) overlap; each once, in the order
+  // of the triangle pairs.
   void collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin);
+  bool sharesVertex(Index firstTriangle, Index secondTriangle) const;
   // Runs test(pairIndex, contact) -> bool over every feature pair (vertex–triangle first, then
   // edge–edge) in parallel and leaves the contacts it accepted in m_contacts, in pair order.
   template <class Test>
@@ -167,6 +169,13 @@ class ContactResolver {
   std::vector<std::array<Index, 2>> m_edges;          // vertex ids of each edge
   Vec3Array m_rest;  // rest positions: features closer than the thickness at rest never repel
   std::vector<Index> m_owner;  // owner of every vertex
+  std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
+  std::vector<std::array<Index, 2>> m_edgeTriangles;  // triangles of each edge (kInvalidIndex: none)
+  std::vector<Aabb> m_vertexBoxes;                    // each vertex's box over the step
+  struct BlockFeatures {
+    std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
+  };
+  std::vector<BlockFeatures> m_blockFeatures;  // per block of triangle pairs
   std::span<const ContactOwner> m_owners;  // of the resolve() under way
   std::span<const ColliderFrame> m_colliders;
   const Vec3Array* m_stepEnd = nullptr;  // x₁ as given to the resolve() under way
@@ -175,8 +184,8 @@ class ContactResolver {
   Vec3Array m_velocity;  // v̄ being corrected
   Vec3Array m_end;       // x₀ + h v̄
   std::vector<TrianglePair> m_trianglePairs;
-  std::vector<std::array<Index, 2>> m_vertexTriangle;  // (vertex, triangle), sorted, unique
-  std::vector<std::array<Index, 2>> m_edgeEdge;        // (edge, edge), sorted, unique
+  std::vector<std::array<Index, 2>> m_vertexTriangle;  // (vertex, triangle), each once
+  std::vector<std::array<Index, 2>> m_edgeEdge;        // (edge, edge), each once
   std::vector<FoundContact> m_found;
   std::vector<Contact> m_contacts;
   std::vector<Index> m_zoneParent;  // union–find over vertices for impact zones
