@@ -26,11 +26,13 @@
 // Colliders. A corrected vertex may be pushed into a collider (a layer pressed into the floor
 // by the one above). Each cloth's collider response (ColliderResponse) runs again on the
 // corrected vertices only, over the frame (collider motion from the frame start to its end);
-// if it moved any of them, the swept tests run once more on the new chord (no proximity). The
-// last word is the swept stage, so no crossing survives; a collider projection undone by it
-// leaves at most a vertex within the thickness of the surface, not through it. Inside the
-// resolver, vertices held by a collider count as heavy and corrected vertices are clamped out of
-// the colliders after every round of impulses (ContactResolver.h, "Colliders").
+// if it moved any of them, the swept tests run once more on the new chord (no proximity), up to
+// three rounds. Inside the resolver, vertices held by a collider count as heavy and corrected
+// vertices are clamped out of the colliders after every round of impulses (ContactResolver.h,
+// "Colliders"), so the swept stage rarely pushes anything back in. The last word is the swept
+// stage: no crossing between cloths survives, guaranteed; that no vertex ends inside a collider
+// is what the clamp and the rounds achieve in the tested scenes, not a proof (an impact zone's
+// rigid motion, for one, ignores colliders).
 //
 // Cost. Nothing when no two participating cloths have overlapping swept bounds (one pass over
 // the vertices per cloth). Otherwise per-cloth BVHs (built once from the rest shape when the set

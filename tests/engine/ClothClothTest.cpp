@@ -143,6 +143,33 @@ TEST(ClothCloth, AFastLayerDoesNotTunnelThroughAPinnedSheet) {
   EXPECT_GT(world.positions(layer).value()[4 * 9 + 4].y(), sheetMiddle);
 }
 
+TEST(ClothCloth, ThreeLayersStayApartWhenOneIsRemovedAndAnotherAdded) {
+  // The set of cloths changes between frames: the contact tables are rebuilt for the new set.
+  World world;
+  const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
+  ClothSettings settings;
+  std::vector<ClothId> cloths;
+  for (int layer = 0; layer < 3; ++layer) {
+    settings.rotation = turnAboutY(0.4 * layer);
+    cloths.push_back(world.createCloth(horizontalSquare(9, 0.4, 0.05 + 0.05 * layer), settings).value());
+  }
+  auto stepAll = [&](int frames) {
+    IntersectionCounter counter(world, cloths);
+    for (int frame = 0; frame < frames; ++frame) {
+      world.step(kFrame);
+      ASSERT_EQ(counter.count(world), 0u) << "frame " << frame;
+      for (ClothId cloth : cloths) ASSERT_GE(closestApproach(world, cloth, floor), 0.0);
+    }
+  };
+  stepAll(30);
+  ASSERT_TRUE(world.destroyCloth(cloths[1]).ok());
+  cloths.erase(cloths.begin() + 1);
+  settings.rotation = turnAboutY(1.0);
+  cloths.push_back(world.createCloth(horizontalSquare(9, 0.4, 0.15), settings).value());
+  stepAll(45);
+  EXPECT_GT(world.stats().clothContacts, 0u);
+}
+
 TEST(ClothCloth, IsBitwiseIdenticalOnOneAndTwoThreads) {
   std::vector<std::uint64_t> hashes[2];
   for (int threads : {1, 2}) {
