@@ -413,7 +413,7 @@ bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<Collider
       ++m_stages.selfCollisionPasses;
       const SelfCollisionReport self = m_selfCollision->resolve(
           m_stepStartPositions, h, m_settings.material.thickness, m_settings.material.friction,
-          m_inverseMasses, m_positions, m_velocities);
+          m_inverseMasses, m_positions, m_velocities, colliders);
       report.selfCollision.proximityContacts += self.proximityContacts;
       report.selfCollision.impacts += self.impacts;
       report.selfCollision.impactZones += self.impactZones;
@@ -529,6 +529,9 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
     const bool collidersChanged =
         colliderFingerprint(colliders, frameDt, &anyMoving) != m_sleepFingerprint || anyMoving;
     if (!m_wakeRequested && !pinsMoved && !collidersChanged) {
+      // The frame starts and ends here: the cloth–cloth pass reads this as the frame's motion.
+      m_savedPositions = m_positions;
+      m_savedVelocities = m_velocities;
       report.sleeping = true;
       return report;
     }

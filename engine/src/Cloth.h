@@ -112,6 +112,22 @@ class Cloth final : public DynamicSystem {
   /// Largest stable explicit step for this cloth (infinity for implicit).
   Real stableStep() const { return m_stableStep; }
 
+  // --- Contact with other cloths (ClothClothCollision, run by World after every cloth has
+  // stepped the frame). ---
+  /// Positions and velocities at the start of the last frame.
+  const Vec3Array& frameStartPositions() const { return m_savedPositions; }
+  const Vec3Array& frameStartVelocities() const { return m_savedVelocities; }
+  /// 1/m per vertex, 0 for pinned vertices.
+  const std::vector<Real>& inverseMasses() const { return m_inverseMasses; }
+  /// 1 for pinned vertices.
+  const std::vector<char>& pinnedMask() const { return m_pinnedMask; }
+  /// The end-of-frame state, for a correction made after the frame (the normals are recomputed).
+  Vec3Array& correctablePositions() {
+    m_normalsValid = false;
+    return m_positions;
+  }
+  Vec3Array& correctableVelocities() { return m_velocities; }
+
  private:
   Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
         const WorldSettings& world, std::vector<Real> masses, TaskSystem* tasks);

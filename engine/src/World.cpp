@@ -2,6 +2,7 @@
 
 #include "Cloth.h"
 #include "FrameCostModel.h"
+#include "ClothClothCollision.h"
 
 #include <weft/threading/Profiler.h>
 
@@ -74,6 +75,7 @@ World::World(const WorldSettings& settings)
     m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{std::max(0, settings.threadCount)});
     m_tasks = m_ownedTasks.get();
   }
+  m_clothContact = std::make_unique<ClothClothCollision>(m_tasks);
 }
 
 int World::threadCount() const { return m_tasks->threadCount(); }
@@ -456,6 +458,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     if (!collider->shape) continue;
     (void)setMotion(*collider->shape, advanceMotion(m_colliderStartMotions[k++], frameDt));
   }
+  collideCloths(frameDt, stats);
   m_time += frameDt;
   stats.simulatedTime = m_time;
   stats.stepMs =
@@ -465,6 +468,31 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
                       plan.cgTolerance > 0 ? plan.cgTolerance : defaultTolerance, costSmoothing);
   m_stats = stats;
   return stats.status;
+}
+
+void World::collideCloths(Real frameDt, StepStats& stats) {
+  m_clothContact->beginFrame();
+  for (std::size_t k = 0; k < m_slots.size(); ++k) {
+    const ClothSlot& slot = *m_slots[k];
+    if (!slot.cloth || !slot.cloth->settings().collideWithOtherCloths) continue;
+    m_clothContact->addCloth(ClothId{std::uint32_t(k + 1), slot.generation}, slot.cloth.get());
+  }
+  // The colliders over the whole frame: from their start motions to where they are now.
+  m_colliderFrames.clear();
+  std::size_t k = 0;
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (!collider->shape) continue;
+    ColliderFrame frame;
+    frame.shape = &*collider->shape;
+    frame.start = m_colliderStartMotions[k++];
+    frame.end = motion(*collider->shape);
+    frame.friction = collider->settings.friction;
+    m_colliderFrames.push_back(frame);
+  }
+  const SelfCollisionReport report = m_clothContact->resolveFrame(frameDt, m_colliderFrames);
+  stats.clothContacts += report.proximityContacts;
+  stats.clothImpacts += report.impacts;
+  stats.clothImpactZones += report.impactZones;
 }
 
 Result<ClothRenderView> World::renderView(ClothId id) const {

@@ -92,6 +92,9 @@ struct StepStats {
   Index sleepingCloths = 0;        ///< cloths asleep during this frame (not stepped)
   Index wokenCloths = 0;           ///< cloths that woke at the start of this frame
   StepStatus status = StepStatus::Ok;  ///< the flags step() returned
+  Index clothContacts = 0;     ///< proximity pairs between different cloths repelled
+  Index clothImpacts = 0;      ///< swept collisions resolved at the frame's cloth–cloth pass
+  Index clothImpactZones = 0;  ///< impact-zone passes of the cloth–cloth pass (fail-safe)
 };
 
 }  // namespace weft

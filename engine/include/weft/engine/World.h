@@ -30,6 +30,7 @@ namespace weft {
 
 struct ColliderFrame;  // internal: a collider as one step sees it
 class FrameCostModel;  // internal: the budget planner
+class ClothClothCollision;  // internal: contact between cloths
 
 /// Handle to a cloth in a World. Zero-initialised = null.
 struct ClothId {
@@ -82,6 +83,10 @@ struct ClothSettings {
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
+  /// Keeps the cloth from passing through other cloths of the world that have this switch on
+  /// too (contact resolved once per frame, after every cloth has stepped). Costs a bounds test
+  /// per frame while the cloths are apart.
+  bool collideWithOtherCloths = true;
 };
 
 /// A snapshot of a World: time, every cloth's positions, velocities, pin targets and solver warm
@@ -256,6 +261,10 @@ class World {
   std::unique_ptr<FrameCostModel> m_costModel;  // fitted to measured frames (budgeted steps)
   StepStats m_stats;
   Real m_time = 0;
+
+  // Contact between cloths, after every cloth has stepped the frame (ClothClothCollision.h).
+  void collideCloths(Real frameDt, StepStats& stats);
+  std::unique_ptr<ClothClothCollision> m_clothContact;
 };
 
 }  // namespace weft

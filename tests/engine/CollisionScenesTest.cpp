@@ -1,0 +1,91 @@
+// A cloth folding onto itself on the floor, two ways: folded in half by pins carried over it
+// like a napkin, and dropped on a corner so that it crumples. In every frame no two triangles
+// intersect (exact triangle–triangle test) and no vertex is inside the floor.
+#include "ContactTestSupport.h"
+
+#include <weft/collision/Plane.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace weft {
+namespace {
+
+using test::closestApproach;
+using test::horizontalSquare;
+using test::IntersectionCounter;
+
+constexpr Real kFrame = 1.0 / 60.0;
+constexpr Index kSide = 15;  // vertices per side
+constexpr Real kSize = 0.6;  // m
+
+TEST(CollisionScenes, ANapkinFoldedInHalfOnTheFloor) {
+  World world;
+  const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
+  // Row 0 is the edge at z = +0.3; its vertices are carried over the cloth to z = −0.3.
+  ClothSettings settings;
+  for (Index c = 0; c < kSide; ++c) settings.pinnedVertices.push_back(c);
+  const ClothId cloth = world.createCloth(horizontalSquare(kSide, kSize, 0.01), settings).value();
+  IntersectionCounter counter(world, {cloth});
+  const std::vector<Vec3> start = world.pinTargets(cloth).value();
+  constexpr int kFoldFrames = 90, kHoldFrames = 60;
+  Index selfContacts = 0;
+  for (int frame = 0; frame < kFoldFrames + kHoldFrames; ++frame) {
+    // A half turn about the x axis through the middle, 2 cm above the floor at its end.
+    const Real s = std::min<Real>(1, Real(frame + 1) / kFoldFrames);
+    const Real angle = M_PI * s;
+    std::vector<Vec3> targets = start;
+    for (Vec3& target : targets) {
+      target.z() = 0.5 * kSize * std::cos(angle);
+      target.y() = 0.01 + 0.01 * s + 0.3 * std::sin(angle);
+    }
+    ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
+    world.step(kFrame);
+    selfContacts += world.stats().selfContacts;
+    ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
+    ASSERT_GE(closestApproach(world, cloth, floor), 0.0) << "a vertex is inside, frame " << frame;
+  }
+  // Folded: the carried edge lies over the far edge, the top half on the bottom half.
+  const std::span<const Vec3> x = world.positions(cloth).value();
+  const Vec3 carried = x[kSide / 2];
+  const Vec3 far = x[(kSide - 1) * kSide + kSide / 2];
+  EXPECT_LT(carried.z(), -0.2);
+  EXPECT_GT(carried.y(), far.y() + ClothMaterial{}.thickness);
+  EXPECT_GT(selfContacts, 100u);
+  // The fold keeps the layers at least ~half a thickness apart where they lie on each other.
+  EXPECT_GT(x[(kSide / 4) * kSide + kSide / 2].y(), x[(3 * kSide / 4) * kSide + kSide / 2].y());
+}
+
+TEST(CollisionScenes, AClothDroppedOnACornerCrumplesOnTheFloor) {
+  World world;
+  const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
+  // Nearly upright (turned a quarter about x, less 0.05 rad), then a diamond (45° about z), so that
+  // it lands on one corner from 30 cm: the lower part buckles and the rest falls onto it.
+  ClothSettings settings;
+  const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2 - 0.05, Vec3::UnitX()).toRotationMatrix();
+  const Mat3 onCorner = Eigen::AngleAxis<Real>(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
+  settings.rotation = onCorner * upright;
+  const std::shared_ptr<const ClothModel> model = horizontalSquare(kSide, kSize, 0.0);
+  // Lift it so that its lowest vertex starts 30 cm above the floor.
+  Real lowest = 1e9;
+  for (const Vec3& p : model->restPositions()) lowest = std::min(lowest, Vec3(settings.rotation * p).y());
+  settings.translation = Vec3(0, 0.3 - lowest, 0);
+  const ClothId cloth = world.createCloth(model, settings).value();
+  IntersectionCounter counter(world, {cloth});
+  Index selfContacts = 0;
+  for (int frame = 0; frame < 150; ++frame) {
+    world.step(kFrame);
+    selfContacts += world.stats().selfContacts + world.stats().selfImpacts;
+    ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
+    ASSERT_GE(closestApproach(world, cloth, floor), 0.0) << "a vertex is inside, frame " << frame;
+  }
+  // Down on the floor, lying on itself in places.
+  Real highest = 0;
+  for (const Vec3& p : world.positions(cloth).value()) highest = std::max(highest, p.y());
+  EXPECT_LT(highest, 0.1);
+  EXPECT_GT(selfContacts, 0u);
+}
+
+}  // namespace
+}  // namespace weft

@@ -1,0 +1,91 @@
+// Checks shared by the contact scenes (ClothClothTest, CollisionScenesTest): intersecting
+// triangle pairs within and between cloths (the exact triangle–triangle test) and the deepest
+// vertex inside a collider.
+#pragma once
+
+#include <weft/collision/Proximity.h>
+#include <weft/collision/SelfIntersectionCounter.h>
+#include <weft/engine/World.h>
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <memory>
+#include <vector>
+
+namespace weft::test {
+
+/// A horizontal square of vertices × vertices at height `height`, centred on the y axis; its
+/// front faces +y.
+inline std::shared_ptr<const ClothModel> horizontalSquare(Index vertices, Real size, Real height) {
+  GridSettings grid;
+  grid.columns = vertices;
+  grid.rows = vertices;
+  grid.width = size;
+  grid.height = size;
+  grid.origin = Vec3(-size / 2, height, size / 2);
+  grid.widthAxis = Vec3(1, 0, 0);
+  grid.heightAxis = Vec3(0, 0, -1);
+  return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+}
+
+/// Counts intersecting triangle pairs of several cloths of one world taken as one mesh: pairs
+/// within each cloth and between any two (pairs sharing a vertex of one cloth are not counted,
+/// as in SelfIntersectionCounter).
+class IntersectionCounter {
+ public:
+  IntersectionCounter(const World& world, std::vector<ClothId> cloths) : m_cloths(std::move(cloths)) {
+    std::vector<Index> indices;
+    Vec3Array positions;
+    for (ClothId cloth : m_cloths) {
+      const ClothRenderView view = world.renderView(cloth).value();
+      const Index offset = Index(positions.size());
+      for (Index index : view.indices) indices.push_back(index + offset);
+      positions.insert(positions.end(), view.positions.begin(), view.positions.end());
+    }
+    m_counter = std::make_unique<SelfIntersectionCounter>(
+        SelfIntersectionCounter::create(indices, positions).value());
+  }
+
+  /// Intersecting pairs at the world's current positions.
+  Index count(const World& world) {
+    m_positions.clear();
+    for (ClothId cloth : m_cloths) {
+      const std::span<const Vec3> x = world.positions(cloth).value();
+      m_positions.insert(m_positions.end(), x.begin(), x.end());
+    }
+    return m_counter->count(m_positions);
+  }
+
+ private:
+  std::vector<ClothId> m_cloths;
+  std::unique_ptr<SelfIntersectionCounter> m_counter;
+  Vec3Array m_positions;
+};
+
+/// Smallest signed distance (m) of any vertex of `cloth` to the collider: negative = inside.
+inline Real closestApproach(const World& world, ClothId cloth, ColliderId collider) {
+  const Shape* shape = world.collider(collider).value();
+  Real closest = std::numeric_limits<Real>::infinity();
+  for (const Vec3& x : world.positions(cloth).value()) {
+    closest = std::min(closest, queryPoint(*shape, x).distance);
+  }
+  return closest;
+}
+
+/// Smallest distance (m) from a vertex of cloth `a` to a triangle of cloth `b` (brute force).
+inline Real closestDistanceBetween(const World& world, ClothId a, ClothId b) {
+  const ClothRenderView second = world.renderView(b).value();
+  Real closest = std::numeric_limits<Real>::infinity();
+  for (const Vec3& x : world.positions(a).value()) {
+    for (std::size_t t = 0; t + 2 < second.indices.size(); t += 3) {
+      const Vec3& p0 = second.positions[second.indices[t]];
+      const Vec3& p1 = second.positions[second.indices[t + 1]];
+      const Vec3& p2 = second.positions[second.indices[t + 2]];
+      closest = std::min(closest, closestPointOnTriangle(x, p0, p1, p2).distance);
+    }
+  }
+  return closest;
+}
+
+}  // namespace weft::test
