@@ -260,11 +260,11 @@ std::vector<SweepConfig> sweepConfigs(const ErrorTimeOptions& options) {
   if (options.full) {
     substeps = {1, 2, 4, 8, 16, 32};
     explicitSubsteps = substeps;
-    tolerances = {1e-2, 1e-3, 1e-4, 1e-6, 1e-8};
+    tolerances = {1e-2, 5e-3, 1e-3, 1e-4, 1e-6, 1e-8};
   } else if (options.quick) {
     substeps = {1, 2, 4, 8};
     explicitSubsteps = {8, 32};
-    tolerances = {1e-2, 1e-4, 1e-8};
+    tolerances = {1e-2, 5e-3, 1e-3, 1e-8};
   } else {
     substeps = {1, 2, 4, 8, 16};
     explicitSubsteps = {4, 8, 16, 32};
@@ -439,7 +439,8 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
     out << "weft-error-time: scene '" << options.scene << "' is unknown; the only scene is curtain\n";
     return 2;
   }
-  for (const std::string& path : {options.csvPath, options.plotPath, options.referenceCache}) {
+  for (const std::string& path :
+       {options.csvPath, options.plotPath, options.markdownPath, options.referenceCache}) {
     if (path.empty()) continue;
     const std::filesystem::path folder = std::filesystem::path(path).parent_path();
     std::error_code error;
@@ -653,6 +654,30 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
     out << "csv: " << options.csvPath << "\n";
   }
   if (!options.plotPath.empty()) writePlot(options.plotPath, runs, onFront, out);
+  if (!options.markdownPath.empty()) {
+    std::ofstream markdown(options.markdownPath);
+    markdown << "| configuration | s per simulated s | RMS error | max error | strain error | "
+                "energy drift | CG per frame |\n|---|---:|---:|---:|---:|---:|---:|\n";
+    for (std::size_t k : frontOrder) {
+      const RunResult& run = runs[k];
+      markdown << "| " << describeConfig(run) << " | " << std::setprecision(3)
+               << run.wallPerSimulated << " | " << run.rmsError << " | " << run.maxError << " | "
+               << run.strainError << " | " << run.energyDrift << " | " << std::setprecision(4)
+               << run.cgIterationsPerFrame << " |\n";
+    }
+    for (std::size_t k = 0; k < runs.size(); ++k) {
+      if (!runs[k].config.isDefaults) continue;
+      markdown << "\nSolverSettings{} (" << describeConfig(runs[k]) << "): " << std::setprecision(3)
+               << runs[k].wallPerSimulated << " s per simulated s, RMS error " << runs[k].rmsError
+               << ", " << (onFront[k] ? "on the Pareto front" : "not on the Pareto front") << ".\n";
+    }
+    markdown << "\nError = distance to the backward-Euler reference at h/" << options.referenceSubsteps
+             << " divided by the cloth's " << length << " m; " << runs.size() << " runs, "
+             << unstable << " unstable left out. Wall times are single runs"
+             << (options.repeats > 1 ? " (fastest of several)" : "")
+             << " on a shared machine: differences under ~10 % are noise.\n";
+    out << (markdown ? "markdown: " : "markdown: could not write ") << options.markdownPath << "\n";
+  }
   return 0;
 }
 

@@ -16,6 +16,7 @@ struct ErrorTimeOptions {
   bool full = false;              ///< every combination, 6 s simulated with the rod gathering
   std::string csvPath;            ///< one row per run; empty = no CSV
   std::string plotPath;           ///< PNG of error against time (gnuplot); empty = no plot
+  std::string markdownPath;       ///< Pareto table and the defaults' place, markdown; empty = none
   std::string referenceCache;     ///< file the reference is read from / written to; empty = none
   Index referenceSubsteps = 16;   ///< substeps per 1/60 s frame of the backward-Euler reference
   int referenceNewtonIterations = 3;  ///< Newton iterations per reference step

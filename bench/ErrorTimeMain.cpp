@@ -16,6 +16,8 @@ int main(int argc, char** argv) {
   app.add_flag("--full", options.full, "Every combination, 6 s simulated (slow)");
   app.add_option("--csv", options.csvPath, "Write one row per run here");
   app.add_option("--plot", options.plotPath, "Write a PNG of error against time here (gnuplot)");
+  app.add_option("--markdown", options.markdownPath,
+                 "Write the Pareto front and where SolverSettings{} sits as a markdown table");
   app.add_option("--reference-cache", options.referenceCache,
                  "Read the reference from this file, or compute and write it there");
   app.add_option("--reference-substeps", options.referenceSubsteps,

@@ -1,6 +1,7 @@
 #include "ClothForces.h"
 
 #include "forces/BaraffWitkin.h"
+#include "forces/IsometricBending.h"
 #include "forces/SpringCondition.h"
 
 #include <weft/threading/GrainSizes.h>
@@ -84,7 +85,11 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
     }
     m_bending = settings.material.bendingStiffness != 0 || settings.material.bendingDamping != 0 ||
                 !settings.skipZeroTerms;
-    if (m_bending) {
+    m_isometricBending =
+        m_bending && settings.material.bendingModel == BendingModel::Isometric;
+    if (m_isometricBending) {
+      buildIsometricBending();
+    } else if (m_bending) {
       m_hinges.reserve(model.hinges().size());
       for (const Hinge& hinge : model.hinges()) {
         Element<4> element{hinge.vertices, {}, Index(m_hinges.size())};
@@ -134,6 +139,57 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
   m_springColours = colourElements(m_springs, model.vertexCount());
 }
 
+void ClothForces::buildIsometricBending() {
+  const std::vector<BendingStencil>& stencils = m_model->bendingStencils();
+  const std::vector<StencilWeight>& weights = m_model->bendingWeights();
+  const Index vertexCount = m_model->vertexCount();
+  // K̂_ab = Σ_s c_s w_sa w_sb: every product as a triplet, stably sorted by (row, column) and
+  // summed in stencil order, so the values do not depend on anything but the model.
+  struct Triplet {
+    Index row, column;
+    Real value;
+  };
+  std::vector<Triplet> triplets;
+  std::vector<Index> useCount(vertexCount + 1, 0);
+  for (const BendingStencil& stencil : stencils) {
+    for (Index a = 0; a < stencil.weightCount; ++a) {
+      const StencilWeight& wa = weights[stencil.firstWeight + a];
+      ++useCount[wa.vertex + 1];
+      for (Index b = 0; b < stencil.weightCount; ++b) {
+        const StencilWeight& wb = weights[stencil.firstWeight + b];
+        triplets.push_back({wa.vertex, wb.vertex, wa.weight * wb.weight * stencil.energyWeight});
+      }
+    }
+  }
+  std::stable_sort(triplets.begin(), triplets.end(), [](const Triplet& a, const Triplet& b) {
+    return a.row != b.row ? a.row < b.row : a.column < b.column;
+  });
+  m_bendingRowOffsets.assign(vertexCount + 1, 0);
+  for (std::size_t k = 0; k < triplets.size(); ++k) {
+    if (k > 0 && triplets[k].row == triplets[k - 1].row &&
+        triplets[k].column == triplets[k - 1].column) {
+      m_bendingEntries.back().value += triplets[k].value;
+      continue;
+    }
+    m_bendingEntries.push_back({triplets[k].column, triplets[k].value, kInvalidIndex});
+    ++m_bendingRowOffsets[triplets[k].row + 1];
+  }
+  for (Index v = 0; v < vertexCount; ++v) m_bendingRowOffsets[v + 1] += m_bendingRowOffsets[v];
+
+  // Transpose of the stencils, for the force f_a = −Σ_v w_va r_v gathered per vertex.
+  for (Index v = 0; v < vertexCount; ++v) useCount[v + 1] += useCount[v];
+  m_stencilUseOffsets = useCount;
+  m_stencilUses.resize(useCount.back());
+  std::vector<Index> fill(useCount.begin(), useCount.end() - 1);
+  for (Index s = 0; s < Index(stencils.size()); ++s) {
+    for (Index a = 0; a < stencils[s].weightCount; ++a) {
+      const StencilWeight& w = weights[stencils[s].firstWeight + a];
+      m_stencilUses[fill[w.vertex]++] = {s, w.weight};
+    }
+  }
+  m_stencilResiduals.assign(stencils.size(), Vec3::Zero());
+}
+
 std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
   std::vector<std::array<Index, 2>> pairs;
   auto addAll = [&pairs](const auto& vertices) {
@@ -143,6 +199,11 @@ std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
   for (const auto& element : m_triangles) addAll(element.vertices);
   for (const auto& element : m_hinges) addAll(element.vertices);
   for (const auto& element : m_springs) addAll(element.vertices);
+  for (Index row = 0; row + 1 < Index(m_bendingRowOffsets.size()); ++row) {
+    for (Index k = m_bendingRowOffsets[row]; k < m_bendingRowOffsets[row + 1]; ++k) {
+      if (m_bendingEntries[k].column > row) pairs.push_back({row, m_bendingEntries[k].column});
+    }
+  }
   return pairs;
 }
 
@@ -158,6 +219,12 @@ void ClothForces::bindMatrix(const BlockSparseMatrix& matrix) {
   for (auto& element : m_triangles) bind(element);
   for (auto& element : m_hinges) bind(element);
   for (auto& element : m_springs) bind(element);
+  for (Index row = 0; row + 1 < Index(m_bendingRowOffsets.size()); ++row) {
+    for (Index k = m_bendingRowOffsets[row]; k < m_bendingRowOffsets[row + 1]; ++k) {
+      m_bendingEntries[k].slot = matrix.slot(row, m_bendingEntries[k].column);
+      assert(m_bendingEntries[k].slot != kInvalidIndex && "matrix built without coupledPairs()");
+    }
+  }
   m_diagonalSlots.resize(m_masses.size());
   for (Index i = 0; i < m_masses.size(); ++i) m_diagonalSlots[i] = matrix.diagonalSlot(i);
 }
@@ -287,6 +354,49 @@ Real ClothForces::evaluate(const Pass& pass) const {
     }
     return blockEnergy;
   });
+
+  if (m_isometricBending) {
+    // E = D/2 Σ_s c_s |r_s|² with r_s = S_s x − α_s n_s; damping k_d acts on S_s v alike.
+    const Real stiffness = material.bendingStiffness, damping = material.bendingDamping;
+    const std::vector<BendingStencil>& stencils = m_model->bendingStencils();
+    const std::span<const StencilWeight> weights = m_model->bendingWeights();
+    const std::span<const Index> ringTriangles = m_model->bendingTriangles();
+    const std::vector<Index>& indices = m_model->indices();
+    energy += tasks.parallelReduce(
+        Index(stencils.size()), kGrainElements, Real(0),
+        [&](Index begin, Index end) {
+          Real blockEnergy = 0;
+          for (Index s = begin; s < end; ++s) {
+            const BendingStencil& stencil = stencils[s];
+            const Vec3 residual = bendingResidual(stencil, weights, ringTriangles, indices, x);
+            const Vec3 rate = stencilVector(stencil, weights, pass.v);
+            blockEnergy += Real(0.5) * stiffness * stencil.energyWeight * residual.squaredNorm();
+            m_stencilResiduals[s] = stencil.energyWeight * (stiffness * residual + damping * rate);
+          }
+          return blockEnergy;
+        },
+        sum);
+    // Per vertex: the force gathered over the stencils that hold it, and its matrix row
+    // −h ∂f/∂v − h² ∂f/∂x = (h k_d + h² D) K̂ ⊗ I₃ with its share of (∂f/∂x)·u = −D K̂ u.
+    const Real matrixScale = pass.h * damping + pass.h * pass.h * stiffness;
+    tasks.parallelFor(Index(m_masses.size()), kGrainMatrixRows, [&](Index begin, Index end, int) {
+      for (Index i = begin; i < end; ++i) {
+        Vec3 force = Vec3::Zero();
+        for (Index k = m_stencilUseOffsets[i]; k < m_stencilUseOffsets[i + 1]; ++k) {
+          force -= m_stencilUses[k].weight * m_stencilResiduals[m_stencilUses[k].stencil];
+        }
+        pass.f[i] += force;
+        if (!jacobians) continue;
+        Vec3 product = Vec3::Zero();
+        for (Index k = m_bendingRowOffsets[i]; k < m_bendingRowOffsets[i + 1]; ++k) {
+          const BendingEntry& entry = m_bendingEntries[k];
+          pass.matrix->block(entry.slot).diagonal().array() += matrixScale * entry.value;
+          product += entry.value * (*pass.velocityForProduct)[entry.column];
+        }
+        (*pass.stiffnessTimesVelocity)[i] -= stiffness * product;
+      }
+    });
+  }
 
   forEachColour(m_springColours, [&](Index begin, Index end) {
     Real blockEnergy = 0;

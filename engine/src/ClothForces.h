@@ -16,6 +16,11 @@
 // curtain, where the whole assembly fits in cache), and per-thread copies of the matrix merged in a
 // fixed order (memory × threads, and a merge as costly as the SpMV). Colouring costs one fork/join
 // per colour: the curtain's triangles take 6 colours, its hinges 9 or so.
+//
+// Isometric bending (forces/IsometricBending.h) needs no colouring: its Hessian is the constant
+// D·K̂ ⊗ I₃ with K̂ = Σ_s c_s w_s w_sᵀ over the stencils, summed once at set-up (in stencil order) into one scalar
+// per matrix block. A step computes each stencil's residual (one writer per stencil), then gathers
+// forces and writes matrix rows per vertex (one writer per row, fixed order): no shared writes.
 #pragma once
 
 #include "forces/Condition.h"
@@ -84,14 +89,15 @@ class ClothForces {
     m_settings.gravity = gravity;
     m_settings.wind = wind;
   }
-  /// True when evaluations include the bending hinges.
-  bool evaluatesBending() const { return !m_hinges.empty(); }
+  /// True when evaluations include bending (isometric stencils or dihedral hinges).
+  bool evaluatesBending() const { return m_isometricBending || !m_hinges.empty(); }
   /// True when assemblies form damping Jacobians (∂f/∂v of the element dampers).
   bool formsDampingJacobians() const { return m_damping; }
 
  private:
   struct Pass;  // one evaluation: what to compute and where to put it
   Real evaluate(const Pass& pass) const;
+  void buildIsometricBending();
 
   template <int N>
   struct Element {
@@ -115,6 +121,23 @@ class ClothForces {
   std::vector<Index> m_triangleColours, m_hingeColours, m_springColours;
   std::vector<Index> m_diagonalSlots;
   Vec3Array m_externalForces;  // N per vertex, or empty
+  // Isometric bending: K̂ by rows (column, value, matrix slot), the stencils that hold each vertex
+  // (for the force gather), and per-stencil scratch c_s (D r_s + k_d S_s v).
+  struct BendingEntry {
+    Index column;
+    Real value;  // 1/m², entry of K̂
+    Index slot;
+  };
+  struct StencilUse {
+    Index stencil;
+    Real weight;
+  };
+  std::vector<Index> m_bendingRowOffsets;
+  std::vector<BendingEntry> m_bendingEntries;
+  std::vector<Index> m_stencilUseOffsets;
+  std::vector<StencilUse> m_stencilUses;
+  mutable Vec3Array m_stencilResiduals;  // written by evaluate(), sized at set-up: no allocation
+  bool m_isometricBending = false;
   TaskSystem* m_tasks = nullptr;
   std::unique_ptr<TaskSystem> m_serialTasks;  // used when m_tasks is null; reused, so no allocation
   bool m_bending = false;  // bending stiffness or damping non-zero

@@ -12,6 +12,7 @@
 #include <weft/engine/ClothModel.h>
 
 #include "forces/BaraffWitkin.h"
+#include "forces/IsometricBending.h"
 
 #include <tiny_obj_loader.h>
 
@@ -351,6 +352,12 @@ Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSetting
                                                model.m_triangles[triangleB].area);
     model.m_hinges.push_back(hinge);
   }
+  // Isometric bending stencils; they need the non-manifold marks, cleared just below.
+  BendingStencils stencils =
+      buildBendingStencils(model.m_restPositions, model.m_indices, model.m_edges);
+  model.m_bendingStencils = std::move(stencils.stencils);
+  model.m_bendingWeights = std::move(stencils.weights);
+  model.m_bendingTriangles = std::move(stencils.triangles);
   for (Edge& edge : model.m_edges) {
     if (edge.triangles[1] == kInvalidIndex - 1) edge.triangles[1] = kInvalidIndex;
   }

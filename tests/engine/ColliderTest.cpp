@@ -48,7 +48,8 @@ TEST(Collider, ClothDropsOntoASphereAndRestsOnIt) {
   EXPECT_GT(world.stats().contacts, 20u);
   // Nearly at rest: the corners, folded where they hang, keep touching themselves and the
   // self-contact response keeps them stirring at ~1 mJ (0.216 kg of cloth: ~0.1 m/s rms), so the
-  // mean over the last half second is bounded rather than one frame's value.
+  // mean over the last half second is bounded rather than one frame's value. Run on, the drape
+  // slides off the sphere (after ~frame 330 with isometric bending): an open friction issue.
   EXPECT_LT(lateEnergy / 30, 2e-3);
 }
 

@@ -16,7 +16,10 @@
 // so w_u and w_v are fixed linear combinations of the three positions. TriangleRest stores the
 // weights of those combinations; the force kernels never see (u, v) again.
 //
-// Hinge convention (one per interior edge, for bending):
+// Bending data for both bending models: BendingStencils per vertex for the isometric (quadratic)
+// energy, the default, and Hinges per interior edge for the dihedral one.
+//
+// Hinge convention (one per interior edge, for dihedral bending):
 //
 //            x2
 //           /  \          triangle A = (x0, x1, x2), with the edge x0 -> x1 in its winding
@@ -55,6 +58,26 @@ struct Hinge {
   /// 1/m⁰ (dimensionless): 3 l² / (A_A + A_B). Bending energy = D/2 · scale · (θ − θ_rest)², so a
   /// bending stiffness D in N·m gives the same curvature energy on any mesh resolution.
   Real stiffnessScale = 0;
+};
+
+/// One weight of an isometric-bending stencil (forces/IsometricBending.h).
+struct StencilWeight {
+  Index vertex = 0;  ///< the vertex the weight multiplies
+  Real weight = 0;   ///< dimensionless; a stencil's weights sum to zero
+};
+
+/// One term of the isometric bending energy D/2 · energyWeight · |S(x) − α n_v(x)|², where
+/// S(x) = Σ weight · x over its StencilWeights is A_v times one entry of the surface Hessian of
+/// the deformation at vertex v (forces/IsometricBending.h explains the choice). Three per vertex.
+struct BendingStencil {
+  Index vertex = 0;         ///< the centre vertex v
+  Index firstWeight = 0;    ///< its weights: ClothModel::bendingWeights()[firstWeight, + weightCount)
+  Index weightCount = 0;    ///< the centre first, then the neighbours in ascending index
+  Real energyWeight = 0;    ///< 1/m², 1/A_v for H_uu and H_vv, 2/A_v for H_uv (A_v: vertex area)
+  /// m, α_v: the rest value of S_v along the rest vertex normal; 0 for a flat rest shape.
+  Real restCurvature = 0;
+  Index firstTriangle = 0;  ///< incident triangles (curved rest only): bendingTriangles()[first, +count)
+  Index triangleCount = 0;  ///< 0 when restCurvature is 0 (the normal is not needed)
 };
 
 /// The three spring families of the classic mass-spring cloth (Provot 1995).
@@ -132,6 +155,13 @@ class ClothModel {
   const std::vector<Index>& indices() const { return m_indices; }
   const std::vector<TriangleRest>& triangles() const { return m_triangles; }
   const std::vector<Hinge>& hinges() const { return m_hinges; }
+  /// Isometric bending terms, three per vertex (vertices next to non-manifold edges have none),
+  /// in vertex order.
+  const std::vector<BendingStencil>& bendingStencils() const { return m_bendingStencils; }
+  /// The weights of all bending stencils (BendingStencil::firstWeight indexes them).
+  const std::vector<StencilWeight>& bendingWeights() const { return m_bendingWeights; }
+  /// Triangles whose normals the curved-rest stencils need (BendingStencil::firstTriangle).
+  const std::vector<Index>& bendingTriangles() const { return m_bendingTriangles; }
   const std::vector<Edge>& edges() const { return m_edges; }
   const std::vector<Spring>& springs() const { return m_springs; }
   /// m², a third of the rest area of every triangle around each vertex (lumped mass = ρ_A · area).
@@ -157,6 +187,9 @@ class ClothModel {
   std::vector<Index> m_indices;
   std::vector<TriangleRest> m_triangles;
   std::vector<Hinge> m_hinges;
+  std::vector<BendingStencil> m_bendingStencils;
+  std::vector<StencilWeight> m_bendingWeights;
+  std::vector<Index> m_bendingTriangles;
   std::vector<Edge> m_edges;
   std::vector<Spring> m_springs;
   std::vector<Real> m_vertexAreas;

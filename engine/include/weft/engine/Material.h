@@ -13,6 +13,17 @@
 
 namespace weft {
 
+/// How the Baraff–Witkin model discretises bending (both take the same D in N·m).
+enum class BendingModel {
+  /// Quadratic energy D/2 |∇²x|² from a per-vertex surface Hessian (plate with Poisson ratio 0,
+  /// after Bergou et al. 2006): the continuum D/2 κ² in every direction, constant Hessian. Default.
+  Isometric,
+  /// Dihedral angle per interior edge (Baraff & Witkin 1998), weight 3 l²/(A_A + A_B): handles
+  /// strongly curved rest shapes, but 2–3× too stiff along grid lines and ≈ 9× along the split
+  /// diagonal of a regular grid.
+  Dihedral,
+};
+
 /// Continuum cloth material for the Baraff–Witkin model (and the mass to give every vertex).
 struct ClothMaterial {
   Real arealDensity = 0.15;           ///< kg/m², mass per rest area; lumped to vertices
@@ -20,6 +31,7 @@ struct ClothMaterial {
   Real weftStretchStiffness = 260.0;  ///< N/m, resistance to stretching along the weft (v)
   Real shearStiffness = 100.0;        ///< N/m, resistance to in-plane shear (angle change of u, v)
   Real bendingStiffness = 2.3e-6;     ///< N·m, resistance to curvature; 0 turns bending off
+  BendingModel bendingModel = BendingModel::Isometric;  ///< discretisation of the bending energy
   Real warpRestScale = 1.0;           ///< rest length factor along the warp (<1 pre-tensions)
   Real weftRestScale = 1.0;           ///< rest length factor along the weft (<1 pre-tensions)
   Real stretchDamping = 0.5;          ///< N·s/m, damps the stretch rate (≈ 2 ms Rayleigh time)
@@ -42,7 +54,7 @@ struct MassSpringMaterial {
 
 /// Which internal forces a cloth uses.
 enum class ForceModel {
-  BaraffWitkin,  ///< continuum stretch, shear and dihedral bending (the default)
+  BaraffWitkin,  ///< continuum stretch, shear and bending (ClothMaterial::bendingModel); default
   MassSpring,    ///< structural, shear and flexion springs
 };
 
