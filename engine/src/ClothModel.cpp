@@ -446,7 +446,10 @@ Result<TriangleMesh> ClothModel::readObj(const std::string& path) {
 Result<ClothModel> ClothModel::loadObj(const std::string& path, const MeshSettings& settings) {
   Result<TriangleMesh> mesh = readObj(path);
   if (!mesh.ok()) return mesh.error();
-  return fromMesh(mesh.value(), settings);
+  Result<ClothModel> model = fromMesh(mesh.value(), settings);
+  // A mesh problem found after reading (NaN, degenerate or repeated corners...) names the file too.
+  if (!model.ok()) return Error{"OBJ file '" + path + "': " + model.error().message};
+  return model;
 }
 
 }  // namespace weft
