@@ -60,9 +60,11 @@ struct WorldState::Data {
 
 WorldState::WorldState() : m_data(std::make_unique<Data>()) {}
 WorldState::~WorldState() = default;
-WorldState::WorldState(const WorldState& other) : m_data(std::make_unique<Data>(*other.m_data)) {}
+// A moved-from state holds no data; copying it gives an empty state, which restoreState refuses.
+WorldState::WorldState(const WorldState& other)
+    : m_data(other.m_data ? std::make_unique<Data>(*other.m_data) : std::make_unique<Data>()) {}
 WorldState& WorldState::operator=(const WorldState& other) {
-  *m_data = *other.m_data;
+  if (this != &other) m_data = other.m_data ? std::make_unique<Data>(*other.m_data) : std::make_unique<Data>();
   return *this;
 }
 WorldState::WorldState(WorldState&&) noexcept = default;
@@ -318,8 +320,8 @@ WorldState World::saveState() const {
 
 Status World::restoreState(const WorldState& state) {
   // Check everything first, so a failed restore changes nothing.
-  if (state.m_data->world != m_identity) {
-    return Error{state.m_data->world == 0
+  if (!state.m_data || state.m_data->world != m_identity) {
+    return Error{!state.m_data || state.m_data->world == 0
                      ? "restoreState: the state is empty; take one with World::saveState()"
                      : "restoreState: the state was saved by another World; restore it into the "
                        "world whose saveState() made it"};

@@ -387,6 +387,16 @@ TEST_F(BadInput, RestoreAnEmptyState) {
   expectRefused(world.restoreState(WorldState{}), {"restoreState", "empty"}, "empty state");
 }
 
+TEST_F(BadInput, RestoreAMovedFromState) {
+  WorldState saved = world.saveState();
+  const WorldState taken = std::move(saved);
+  // NOLINTNEXTLINE(bugprone-use-after-move): the point of the test
+  expectRefused(world.restoreState(saved), {"restoreState", "empty"}, "moved-from state");
+  const WorldState copyOfMoved = saved;
+  expectRefused(world.restoreState(copyOfMoved), {"restoreState", "empty"}, "copy of a moved-from state");
+  EXPECT_TRUE(world.restoreState(taken).ok());
+}
+
 TEST_F(BadInput, RestoreAfterTheCollidersWereDestroyed) {
   const WorldState saved = world.saveState();
   ASSERT_TRUE(world.destroyCollider(sphere).ok());
