@@ -52,6 +52,17 @@ bool colliderNear(const Shape& shape, const Aabb& points, Real margin) {
   }
   return true;
 }
+// An edge stretched beyond this strain (l / l_rest − 1) at the end of a frame, and more than at
+// the frame start, means the integration diverged: cloth tears long before, and even pins
+// teleported by metres leave the implicit solution far below it (the stress suite's scenario 10
+// measures the worst physical case). Not the material's strain limit: a health alarm.
+constexpr Real kDivergedStrain = 99;
+// Kinetic energy at the end of a frame above this multiple of what the frame could supply
+// (kinetic + elastic energy at its start, the cloth thrown at the fastest driver's speed, and a
+// fall through its own size) means energy came from nowhere: a diverging integration.
+constexpr Real kEnergyJumpFactor = 100;
+// m/s: a speed scale below which no energy is suspicious (round-off on a cloth at rest).
+constexpr Real kQuietSpeed = 0.01;
 
 std::string checkNonNegative(const char* field, Real value, const char* unit) {
   if (std::isfinite(value) && value >= 0) return {};
@@ -97,6 +108,15 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
        }) {
     if (!problem.empty()) return "cloth settings: " + problem;
   }
+  if (int(solver.integrator) < int(IntegratorKind::ExplicitEuler) ||
+      int(solver.integrator) > int(IntegratorKind::ImplicitEuler)) {
+    return "cloth settings: solver.integrator = " + std::to_string(int(solver.integrator)) +
+           " is not an IntegratorKind; use one of the enumerators";
+  }
+  if (settings.forceModel != ForceModel::BaraffWitkin && settings.forceModel != ForceModel::MassSpring) {
+    return "cloth settings: forceModel = " + std::to_string(int(settings.forceModel)) +
+           " is not a ForceModel; use BaraffWitkin or MassSpring";
+  }
   if (solver.cgMaxIterations < 1) return "cloth settings: solver.cgMaxIterations must be at least 1";
   if (solver.newtonIterations < 0) return "cloth settings: solver.newtonIterations must be at least 0";
   if (solver.maxSubsteps < 1) return "cloth settings: solver.maxSubsteps must be at least 1";
@@ -106,6 +126,21 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
   if (!(settings.rotation.transpose() * settings.rotation).isApprox(Mat3::Identity(), 1e-6) ||
       settings.rotation.determinant() < 0) {
     return "cloth settings: rotation is not a proper rotation matrix (orthonormal, det +1)";
+  }
+  if (!settings.vertexMasses.empty()) {
+    if (settings.vertexMasses.size() != model->vertexCount()) {
+      return "cloth settings: vertexMasses has " + std::to_string(settings.vertexMasses.size()) +
+             " entries for a model of " + std::to_string(model->vertexCount()) +
+             " vertices; give one mass per vertex, or none to use material.arealDensity";
+    }
+    for (std::size_t i = 0; i < settings.vertexMasses.size(); ++i) {
+      if (!(std::isfinite(settings.vertexMasses[i]) && settings.vertexMasses[i] > 0)) {
+        std::ostringstream text;
+        text << "cloth settings: vertexMasses[" << i << "] = " << settings.vertexMasses[i]
+             << " kg: must be finite and greater than 0";
+        return text.str();
+      }
+    }
   }
   std::vector<Index> pins = settings.pinnedVertices;
   std::sort(pins.begin(), pins.end());
@@ -127,7 +162,9 @@ Result<std::unique_ptr<Cloth>> Cloth::create(std::shared_ptr<const ClothModel> m
                                              const ClothSettings& settings,
                                              const WorldSettings& world, TaskSystem* tasks) {
   if (std::string problem = validate(model.get(), settings); !problem.empty()) return Error{problem};
-  std::vector<Real> masses = model->vertexMasses(settings.material.arealDensity);
+  std::vector<Real> masses = settings.vertexMasses.empty()
+                                ? model->vertexMasses(settings.material.arealDensity)
+                                : settings.vertexMasses;
   return std::unique_ptr<Cloth>(
       new Cloth(std::move(model), settings, world, std::move(masses), tasks));
 }
@@ -371,8 +408,8 @@ void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                                m_pinnedMask, filter);
 }
 
-bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
-                        ClothFrameReport& report) {
+HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
+                                 std::span<ColliderFrame> colliders, ClothFrameReport& report) {
   const Real h = frameDt / substeps;
   const RigidMotion* frameStart = m_frameStartMotions.data();
   for (Index substep = 0; substep < substeps; ++substep) {
@@ -424,20 +461,53 @@ bool Cloth::runSubsteps(Real t, Real frameDt, Index substeps, std::span<Collider
     report.integrator.cgResidual = substepReport.cgResidual;
     report.integrator.cgConverged = report.integrator.cgConverged && substepReport.cgConverged;
     report.integrator.potentialEnergy = substepReport.potentialEnergy;
+    if (substep == 0) m_frameStartPotential = substepReport.potentialEnergy;
     report.integrator.assemblyMs += substepReport.assemblyMs;
     report.integrator.solveMs += substepReport.solveMs;
     report.integrator.releasedContacts += substepReport.releasedContacts;
     // A cheap health check each substep: a NaN spreads through the whole mesh within one solve,
     // and a diverging explicit method passes any physical speed within a few substeps.
     WEFT_PROFILE_ZONE("health");
-    bool healthy = true;
-    for (const Vec3& x : m_positions) healthy = healthy && x.allFinite();
+    bool finite = true, slow = true;
+    for (const Vec3& x : m_positions) finite = finite && x.allFinite();
     for (const Vec3& v : m_velocities) {
-      healthy = healthy && v.allFinite() && v.squaredNorm() < kDivergedSpeed * kDivergedSpeed;
+      finite = finite && v.allFinite();
+      slow = slow && v.squaredNorm() < kDivergedSpeed * kDivergedSpeed;
     }
-    if (!healthy) return false;
+    if (!finite) return HealthFailure::NonFinite;
+    if (!slow) return HealthFailure::Speed;
   }
-  return true;
+  return HealthFailure::None;
+}
+
+HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic) const {
+  const Real strain = maxStrain();
+  if (strain > kDivergedStrain && strain > startStrain) return HealthFailure::Strain;
+  // The energy the frame could give the cloth: what it had (kinetic, and elastic: the reported
+  // potential minus gravity's part, −Σ m g·x), the whole cloth thrown at the fastest driver's
+  // speed (pins, collider surfaces, wind), and a free fall through its own size.
+  const std::vector<Real>& mass = masses();
+  const Vec3& gravity = m_forces.settings().gravity;
+  Real totalMass = 0, gravityPotential = 0;
+  for (Index i = 0; i < vertexCount(); ++i) {
+    totalMass += mass[i];
+    gravityPotential -= mass[i] * gravity.dot(m_savedPositions[i]);
+  }
+  const Real elastic = std::max<Real>(0, m_frameStartPotential - gravityPotential);
+  const Real size = m_model->characteristicLength();
+  Real driverSpeed = std::max(kQuietSpeed, m_forces.settings().wind.norm());
+  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
+    driverSpeed = std::max(driverSpeed, (m_pinEnd[k] - m_pinStart[k]).norm() / m_frameLength);
+  }
+  for (const RigidMotion& motion : m_frameStartMotions) {
+    const Real reach = (motion.pose.position - m_savedPositions[0]).norm() + size;
+    driverSpeed = std::max(driverSpeed, motion.linearVelocity.norm() +
+                                            motion.angularVelocity.norm() * reach);
+  }
+  const Real available = startKinetic + elastic +
+                         0.5 * totalMass * (driverSpeed * driverSpeed + 2 * gravity.norm() * size);
+  if (kineticEnergy() > kEnergyJumpFactor * available) return HealthFailure::EnergyJump;
+  return HealthFailure::None;
 }
 
 void Cloth::save(SavedState& out) const {
@@ -556,6 +626,8 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
 
   m_savedPositions = m_positions;
   m_savedVelocities = m_velocities;
+  const Real startStrain = maxStrain();
+  const Real startKinetic = kineticEnergy();
   m_frameStart = t;
   m_frameLength = frameDt;
   // The friction of a pair is the geometric mean of the two coefficients.
@@ -565,13 +637,20 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
   m_frameStartMotions.clear();  // keeps its capacity: no allocation once colliders are known
   for (const ColliderFrame& collider : colliders) m_frameStartMotions.push_back(collider.start);
 
-  // Health monitor: a frame that ends non-finite or diverging is undone and retried with twice
-  // as many substeps, up to kMaxRetries times; if it still fails, the cloth stays where the frame
-  // started. Either way the caller hears of it and never sees a NaN.
+  // Health monitor: a frame that ends non-finite or diverging (too fast, too stretched, energy
+  // from nowhere) is undone and retried with twice as many substeps, up to kMaxRetries times; if
+  // it still fails, the cloth stays where the frame started. Either way the caller hears of it,
+  // with the check that failed, and never sees a NaN.
   for (int attempt = 0;; ++attempt) {
     report.substeps = substeps;
     report.integrator = IntegratorReport{};
-    if (runSubsteps(t, frameDt, substeps, colliders, report)) break;
+    HealthFailure failure = runSubsteps(t, frameDt, substeps, colliders, report);
+    if (failure == HealthFailure::None) {
+      WEFT_PROFILE_ZONE("health");
+      failure = checkFrameHealth(startStrain, startKinetic);
+    }
+    if (failure == HealthFailure::None) break;
+    report.healthFailure = failure;
     m_positions = m_savedPositions;
     m_velocities = m_savedVelocities;
     m_integrator->reset();  // the failed attempt's Δv is no warm start

@@ -39,6 +39,7 @@ struct ClothFrameReport {
   Index contacts = 0;  ///< vertices touching colliders at the end of the frame
   IntegratorReport integrator;
   StepStatus status = StepStatus::Ok;
+  HealthFailure healthFailure = HealthFailure::None;  ///< why the last failed attempt failed
 };
 
 class Cloth final : public DynamicSystem {
@@ -132,8 +133,9 @@ class Cloth final : public DynamicSystem {
   Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
         const WorldSettings& world, std::vector<Real> masses, TaskSystem* tasks);
   void estimateStiffestMode();
-  // Runs `substeps` substeps of the frame; false when the state became non-finite or diverged.
-  bool runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
+  // Runs `substeps` substeps of the frame; the failed check when the state became non-finite or
+  // a vertex too fast (checked every substep), None otherwise.
+  HealthFailure runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
                    ClothFrameReport& report);
   // Colliders whose box comes within the contact distance of `points` go to m_nearColliders;
   // counts both kinds in m_stages.
@@ -157,6 +159,9 @@ class Cloth final : public DynamicSystem {
   bool m_normalsValid = false;
   // Frame-start copies for rollback when a frame produces non-finite state.
   Vec3Array m_savedPositions, m_savedVelocities;
+  Real m_frameStartPotential = 0;  // J, elastic + gravity at the frame start (first substep)
+  // The end-of-attempt checks (strain, energy jump) against the frame start; see stepFrame().
+  HealthFailure checkFrameHealth(Real startStrain, Real startKinetic) const;
 
   std::vector<Index> m_pinnedSorted;   // pinned vertices, increasing
   std::vector<char> m_pinnedMask;      // 1 for pinned vertices

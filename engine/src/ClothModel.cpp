@@ -472,7 +472,10 @@ Result<TriangleMesh> ClothModel::parseObj(std::string_view text, std::string_vie
 Result<ClothModel> ClothModel::loadObj(const std::string& path, const MeshSettings& settings) {
   Result<TriangleMesh> mesh = readObj(path);
   if (!mesh.ok()) return mesh.error();
-  return fromMesh(mesh.value(), settings);
+  Result<ClothModel> model = fromMesh(mesh.value(), settings);
+  // A mesh problem found after reading (NaN, degenerate or repeated corners...) names the file too.
+  if (!model.ok()) return Error{"OBJ file '" + path + "': " + model.error().message};
+  return model;
 }
 
 }  // namespace weft

@@ -7,6 +7,7 @@
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -38,6 +39,17 @@ struct ColliderAttachment {
   Vec3 localOffset = Vec3::Zero();  // m, the vertex in the collider's body frame
 };
 
+const char* describe(HealthFailure failure) {
+  switch (failure) {
+    case HealthFailure::None: return "none";
+    case HealthFailure::NonFinite: return "non-finite";
+    case HealthFailure::Speed: return "speed";
+    case HealthFailure::Strain: return "strain";
+    case HealthFailure::EnergyJump: return "energy-jump";
+  }
+  return "unknown";
+}
+
 struct World::ClothSlot {
   std::unique_ptr<Cloth> cloth;  // null when free
   std::uint32_t generation = 1;
@@ -51,6 +63,7 @@ struct World::ColliderSlot {
 };
 
 struct WorldState::Data {
+  std::uint64_t world = 0;  // World::m_identity of the world that saved it (0: none)
   Real time = 0;
   std::uint64_t frame = 0;
   std::vector<std::pair<ClothId, Cloth::SavedState>> cloths;
@@ -59,16 +72,25 @@ struct WorldState::Data {
 
 WorldState::WorldState() : m_data(std::make_unique<Data>()) {}
 WorldState::~WorldState() = default;
-WorldState::WorldState(const WorldState& other) : m_data(std::make_unique<Data>(*other.m_data)) {}
+// A moved-from state holds no data; copying it gives an empty state, which restoreState refuses.
+WorldState::WorldState(const WorldState& other)
+    : m_data(other.m_data ? std::make_unique<Data>(*other.m_data) : std::make_unique<Data>()) {}
 WorldState& WorldState::operator=(const WorldState& other) {
-  *m_data = *other.m_data;
+  if (this != &other) m_data = other.m_data ? std::make_unique<Data>(*other.m_data) : std::make_unique<Data>();
   return *this;
 }
 WorldState::WorldState(WorldState&&) noexcept = default;
 WorldState& WorldState::operator=(WorldState&&) noexcept = default;
 
+namespace {
+// Identities of worlds, for WorldState: never 0, never reused within a process.
+std::atomic<std::uint64_t> g_nextWorldIdentity{1};
+}  // namespace
+
 World::World(const WorldSettings& settings)
-    : m_settings(settings), m_costModel(std::make_unique<FrameCostModel>()) {
+    : m_settings(settings),
+      m_costModel(std::make_unique<FrameCostModel>()),
+      m_identity(g_nextWorldIdentity.fetch_add(1)) {
   if (settings.taskSystem) {
     m_tasks = settings.taskSystem;
   } else {
@@ -441,6 +463,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.selfImpacts += report.selfCollision.impacts;
     stats.impactZones += report.selfCollision.impactZones;
     stats.status |= report.status;
+    if (stats.healthFailure == HealthFailure::None) stats.healthFailure = report.healthFailure;
     stats.substeps = std::max(stats.substeps, report.substeps);
     stats.linearSolves += report.integrator.linearSolves;
     stats.cgIterations += report.integrator.cgIterations;
@@ -525,6 +548,7 @@ Result<Index> World::plannedSubsteps(ClothId id, Real frameDt) const {
 
 WorldState World::saveState() const {
   WorldState state;
+  state.m_data->world = m_identity;
   state.m_data->time = m_time;
   state.m_data->frame = m_stats.frame;
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
@@ -544,6 +568,12 @@ WorldState World::saveState() const {
 
 Status World::restoreState(const WorldState& state) {
   // Check everything first, so a failed restore changes nothing.
+  if (!state.m_data || state.m_data->world != m_identity) {
+    return Error{!state.m_data || state.m_data->world == 0
+                     ? "restoreState: the state is empty; take one with World::saveState()"
+                     : "restoreState: the state was saved by another World; restore it into the "
+                       "world whose saveState() made it"};
+  }
   for (const auto& [id, saved] : state.m_data->cloths) {
     const ClothSlot* slot = find(id);
     if (!slot) return staleHandle("restoreState: the saved cloth", id);

