@@ -464,7 +464,6 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
     if (substep == 0) m_frameStartPotential = substepReport.potentialEnergy;
     report.integrator.assemblyMs += substepReport.assemblyMs;
     report.integrator.solveMs += substepReport.solveMs;
-    report.integrator.releasedContacts += substepReport.releasedContacts;
     // A cheap health check each substep: a NaN spreads through the whole mesh within one solve,
     // and a diverging explicit method passes any physical speed within a few substeps.
     WEFT_PROFILE_ZONE("health");
@@ -485,7 +484,8 @@ HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic) const
   if (strain > kDivergedStrain && strain > startStrain) return HealthFailure::Strain;
   // The energy the frame could give the cloth: what it had (kinetic, and elastic: the reported
   // potential minus gravity's part, −Σ m g·x), the whole cloth thrown at the fastest driver's
-  // speed (pins, collider surfaces, wind), and a free fall through its own size.
+  // speed (pins, collider surfaces, wind), a free fall through its own size, and the work of
+  // the per-vertex external forces.
   const std::vector<Real>& mass = masses();
   const Vec3& gravity = m_forces.settings().gravity;
   Real totalMass = 0, gravityPotential = 0;
@@ -504,7 +504,17 @@ HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic) const
     driverSpeed = std::max(driverSpeed, motion.linearVelocity.norm() +
                                             motion.angularVelocity.norm() * reach);
   }
-  const Real available = startKinetic + elastic +
+  // Work of the caller's per-vertex forces: at most |F| times how far the vertex can go (its
+  // size, its start speed over the frame, and the force's own push).
+  Real externalWork = 0;
+  const Vec3Array& external = m_forces.externalForces();
+  for (std::size_t i = 0; i < external.size(); ++i) {
+    const Real force = external[i].norm();
+    if (force == 0) continue;
+    const Real T = m_frameLength;
+    externalWork += force * (size + m_savedVelocities[i].norm() * T + force * T * T / mass[i]);
+  }
+  const Real available = startKinetic + elastic + externalWork +
                          0.5 * totalMass * (driverSpeed * driverSpeed + 2 * gravity.norm() * size);
   if (kineticEnergy() > kEnergyJumpFactor * available) return HealthFailure::EnergyJump;
   return HealthFailure::None;

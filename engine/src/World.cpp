@@ -471,7 +471,6 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.potentialEnergy += report.integrator.potentialEnergy;
     stats.assemblyMs += report.integrator.assemblyMs;
     stats.solveMs += report.integrator.solveMs;
-    stats.releasedContacts += report.integrator.releasedContacts;
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxStrain = std::max(stats.maxStrain, cloth.maxStrain());
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());

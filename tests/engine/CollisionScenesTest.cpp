@@ -60,10 +60,11 @@ TEST(CollisionScenes, ANapkinFoldedInHalfOnTheFloor) {
 TEST(CollisionScenes, AClothDroppedOnACornerCrumplesOnTheFloor) {
   World world;
   const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
-  // Nearly upright (turned a quarter about x, less 0.05 rad), then a diamond (45° about z), so that
-  // it lands on one corner from 30 cm: the lower part buckles and the rest falls onto it.
+  // Upright (turned a quarter about x), then a diamond (45° about z), so that it lands on one
+  // corner from 30 cm: the lower part buckles and the rest falls onto it. (Tilted by 0.05 rad,
+  // as first written, the cloth with isometric bending topples flat without touching itself.)
   ClothSettings settings;
-  const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2 - 0.05, Vec3::UnitX()).toRotationMatrix();
+  const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitX()).toRotationMatrix();
   const Mat3 onCorner = Eigen::AngleAxis<Real>(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
   settings.rotation = onCorner * upright;
   const std::shared_ptr<const ClothModel> model = horizontalSquare(kSide, kSize, 0.0);

@@ -54,26 +54,6 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   report.cgConverged = report.cgConverged && solve.converged;
 }
 
-Index ImplicitEuler::releaseAdhesiveContacts(const DynamicSystem& system) {
-  // The solve meets A Δv = b in the free directions only; along a constrained direction n the
-  // difference A Δv − b is h times the force the constraint applied. Contact constraints are the
-  // one-direction kind (pins prescribe all three), and n points out of the collider, so a
-  // negative n·(A Δv − b) is a pull.
-  const BlockSparseMatrix& matrix = system.systemMatrix();
-  Index released = 0;
-  for (Index vertex = 0; vertex < m_filter.size(); ++vertex) {
-    if (m_filter.kind(vertex) != ConstraintKind::OneDirection) continue;
-    const Vec3& normal = m_filter.direction(vertex, 0);
-    const Real reaction =
-        normal.dot(matrix.multiplyRow(vertex, m_correction) - m_rightHandSide[vertex]);
-    if (reaction < 0) {
-      m_filter.setFree(vertex);
-      ++released;
-    }
-  }
-  return released;
-}
-
 void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
                          IntegratorReport& report) {
   const Index n = system.vertexCount();
@@ -106,15 +86,6 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
     m_correction[i] = (m_settings.warmStart && m_hasWarmStart) ? m_deltaV[i] : Vec3::Zero();
   }
   solve(system, report);
-  // A contact may only push (Baraff & Witkin 1998, §5.3). A constraint that had to pull the
-  // vertex toward the collider — a collider moving away faster than the cloth falls back, cloth
-  // springing off a surface — is released and the step solved again without it, warm-started
-  // from this solution. Without this the cloth sticks to a withdrawing collider and is dragged
-  // along by it.
-  if (const Index released = releaseAdhesiveContacts(system); released > 0) {
-    report.releasedContacts += released;
-    solve(system, report);
-  }
   m_deltaV = m_correction;
 
   // Newton iterations on M Δv = h f(x_n + h(v_n + Δv), v_n + Δv); pinned vertices stay on target.

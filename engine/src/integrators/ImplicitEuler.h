@@ -41,8 +41,6 @@ class ImplicitEuler final : public Integrator {
  private:
   void resize(Index vertexCount);
   void solve(DynamicSystem& system, IntegratorReport& report);
-  // Frees contact constraints whose reaction pulls the vertex into its collider; returns how many.
-  Index releaseAdhesiveContacts(const DynamicSystem& system);
 
   SolverSettings m_settings;
   FilteredPcg m_pcg;

@@ -24,9 +24,6 @@ struct IntegratorReport {
   Real potentialEnergy = 0;   ///< J, at the start of the step (as evaluated by the method)
   Real assemblyMs = 0;        ///< ms spent evaluating forces and assembling the system
   Real solveMs = 0;           ///< ms spent in PCG solves
-  /// Collider contacts released in the solve because they pulled the cloth toward the collider
-  /// (implicit only; see ImplicitEuler::releaseAdhesiveContacts).
-  Index releasedContacts = 0;
 };
 
 class Integrator {

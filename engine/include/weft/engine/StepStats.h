@@ -78,9 +78,6 @@ struct StepStats {
   Index selfContacts = 0;      ///< self-proximity pairs repelled (all substeps)
   Index selfImpacts = 0;       ///< swept self-collisions resolved by impulses (all substeps)
   Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
-  /// Collider contacts released in the implicit solve because holding them would have pulled
-  /// the cloth toward the collider (all substeps)
-  Index releasedContacts = 0;
   /// Vertices the self-collision last resort held at their step start because impulses and
   /// impact zones did not clear their contacts (all substeps): the contacts the engine did not
   /// resolve physically. They never cross; they stop instead.

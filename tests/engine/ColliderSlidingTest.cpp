@@ -1,10 +1,6 @@
 // A collider contact may only push: a sphere that pushes into a hanging sheet and then
-// withdraws faster than the sheet falls back must leave it behind, not drag it along
-// (Baraff & Witkin 1998 §5.3 release the constraints whose force turns adhesive).
-#include "integrators/Integrator.h"
-#include "solver/BlockSparseMatrix.h"
-#include "solver/VertexFilter.h"
-
+// withdraws faster than the sheet falls back must leave it behind, not drag it along, and a
+// floor must let go of cloth pulled up off it.
 #include <weft/collision/Plane.h>
 #include <weft/collision/Sphere.h>
 #include <weft/engine/World.h>
@@ -15,62 +11,6 @@
 
 namespace weft {
 namespace {
-
-// One particle resting on a floor (normal +y), held by a spring towards an anchor above or
-// below it. The contact constrains its normal velocity change to zero, as Cloth does for a
-// vertex predicted to end within the thickness.
-class ParticleOnFloor final : public DynamicSystem {
- public:
-  explicit ParticleOnFloor(Real anchorHeight)
-      : m_anchor(0.0, anchorHeight, 0.0), m_matrix(1, std::span<const std::array<Index, 2>>()) {}
-  Index vertexCount() const override { return 1; }
-  const std::vector<Real>& masses() const override { return m_masses; }
-  Real computeForces(const Vec3Array& x, const Vec3Array&, Real, Vec3Array& f) override {
-    f.resize(1);
-    f[0] = -kStiffness * (x[0] - m_anchor);
-    return 0.5 * kStiffness * (x[0] - m_anchor).squaredNorm();
-  }
-  Real linearize(const Vec3Array& x, const Vec3Array& v, Real t, Real h, Vec3Array& f,
-                 const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) override {
-    const Real energy = computeForces(x, v, t, f);
-    m_matrix.block(m_matrix.diagonalSlot(0)) = (m_masses[0] + h * h * kStiffness) * Mat3::Identity();
-    stiffnessTimesVelocity.resize(1);
-    stiffnessTimesVelocity[0] = -kStiffness * velocityForProduct[0];
-    return energy;
-  }
-  const BlockSparseMatrix& systemMatrix() const override { return m_matrix; }
-  std::span<const Index> prescribedVertices() const override { return {}; }
-  void applyPrescribedMotion(Real, Vec3Array&, Vec3Array&) const override {}
-  void constrainContacts(const Vec3Array&, const Vec3Array&, Real, VertexFilter& filter) override {
-    filter.setConstrained(0, Vec3::UnitY(), Vec3::Zero());
-  }
-
- private:
-  static constexpr Real kStiffness = 10.0;  // N/m
-  std::vector<Real> m_masses{0.01};         // kg
-  Vec3 m_anchor;
-  BlockSparseMatrix m_matrix;
-};
-
-TEST(ContactRelease, AContactThatWouldPullIsReleasedAndOneThatPushesIsKept) {
-  for (const Real anchorHeight : {+1.0, -1.0}) {
-    ParticleOnFloor system(anchorHeight);
-    std::unique_ptr<Integrator> integrator =
-        Integrator::create(IntegratorKind::ImplicitEuler, SolverSettings{});
-    Vec3Array x{Vec3::Zero()}, v{Vec3::Zero()};
-    IntegratorReport report;
-    integrator->step(system, x, v, 0.0, 1.0 / 60.0, report);
-    if (anchorHeight > 0) {
-      // Pulled up: holding it on the floor would take a pull from the floor. Released, it rises.
-      EXPECT_EQ(report.releasedContacts, 1u);
-      EXPECT_GT(v[0].y(), 0.0);
-    } else {
-      // Pressed down: the floor pushes back and the contact holds it exactly.
-      EXPECT_EQ(report.releasedContacts, 0u);
-      EXPECT_EQ(v[0].y(), 0.0);
-    }
-  }
-}
 
 struct SheetAndSphere {
   std::unique_ptr<World> world;
@@ -102,7 +42,7 @@ SheetAndSphere pushedSheet() {
   return scene;
 }
 
-TEST(ContactRelease, AWithdrawingSphereLeavesTheSheetAsIfItHadVanished) {
+TEST(ColliderSliding, AWithdrawingSphereLeavesTheSheetAsIfItHadVanished) {
   // Twin runs from the same pushed state: in one the sphere pulls back at 4 m/s, far faster
   // than the sheet swings back; in the other it simply disappears. A contact that may only
   // push cannot hold the sheet, so both sheets must swing back alike. One that may pull drags
@@ -130,7 +70,7 @@ TEST(ContactRelease, AWithdrawingSphereLeavesTheSheetAsIfItHadVanished) {
   EXPECT_LT(largestGap, 0.01) << "m: the withdrawing sphere dragged the sheet";
 }
 
-TEST(ContactRelease, ClothLyingOnTheFloorLiftsOffWhenPulledUp) {
+TEST(ColliderSliding, ClothLyingOnTheFloorLiftsOffWhenPulledUp) {
   // A sheet lying on the floor, one edge pinned and yanked up 1.5 m in half a second: floor
   // contacts must let go of the rows the edge pulls up instead of holding them down and
   // stretching the edge between them.
