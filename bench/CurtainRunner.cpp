@@ -1,6 +1,6 @@
 #include "CurtainRunner.h"
 
-#include "Statistics.h"
+#include <weft/threading/SampleStatistics.h>
 
 #include <weft/collision/SelfIntersectionCounter.h>
 #include <weft/scenes/Curtain.h>

@@ -13,7 +13,7 @@
 #include "BulletCurtain.h"
 #include "ClothMeter.h"
 
-#include "../Statistics.h"
+#include <weft/threading/SampleStatistics.h>
 
 #include <weft/scenes/Curtain.h>
 

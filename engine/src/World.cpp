@@ -437,16 +437,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
     if (!slot->cloth) continue;
     Cloth& cloth = *slot->cloth;
-    m_colliderFrames.clear();
-    std::size_t k = 0;
-    for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-      if (!collider->shape) continue;
-      ColliderFrame frame;
-      frame.shape = &*collider->shape;
-      frame.start = frame.end = m_colliderStartMotions[k++];
-      frame.friction = collider->settings.friction;
-      m_colliderFrames.push_back(frame);
-    }
+    gatherColliderFrames(/*untilNow=*/false);
     const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames, plan);
     stats.sleepingCloths += report.sleeping;
     stats.wokenCloths += report.woke;
@@ -492,6 +483,20 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
   return stats.status;
 }
 
+void World::gatherColliderFrames(bool untilNow) {
+  m_colliderFrames.clear();
+  std::size_t k = 0;
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (!collider->shape) continue;
+    ColliderFrame frame;
+    frame.shape = &*collider->shape;
+    frame.start = m_colliderStartMotions[k++];
+    frame.end = untilNow ? motion(*collider->shape) : frame.start;
+    frame.friction = collider->settings.friction;
+    m_colliderFrames.push_back(frame);
+  }
+}
+
 void World::collideCloths(Real frameDt, StepStats& stats) {
   m_clothContact->beginFrame();
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
@@ -500,17 +505,7 @@ void World::collideCloths(Real frameDt, StepStats& stats) {
     m_clothContact->addCloth(ClothId{std::uint32_t(k + 1), slot.generation}, slot.cloth.get());
   }
   // The colliders over the whole frame: from their start motions to where they are now.
-  m_colliderFrames.clear();
-  std::size_t k = 0;
-  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (!collider->shape) continue;
-    ColliderFrame frame;
-    frame.shape = &*collider->shape;
-    frame.start = m_colliderStartMotions[k++];
-    frame.end = motion(*collider->shape);
-    frame.friction = collider->settings.friction;
-    m_colliderFrames.push_back(frame);
-  }
+  gatherColliderFrames(/*untilNow=*/true);
   const SelfCollisionReport report = m_clothContact->resolveFrame(frameDt, m_colliderFrames);
   stats.clothContacts += report.proximityContacts;
   stats.clothImpacts += report.impacts;

@@ -5,7 +5,7 @@
 // Figures are wall-clock milliseconds on whatever else the machine is doing: compare them as
 // ratios between runs of one invocation, not across machines or invocations.
 #include "Commands.h"
-#include "FrameStatistics.h"
+#include <weft/threading/SampleStatistics.h>
 
 #include <weft/scenes/ScriptedScene.h>
 
@@ -47,18 +47,18 @@ int benchScene(const BenchOptions& options, std::ostream& out) {
     const std::uint64_t hash = scene.world().stateHash();
     if (run == 0) firstHash = hash;
     sameBits = sameBits && hash == firstHash;
-    medians.push_back(nearestRankPercentile(ms, 50));
+    medians.push_back(percentile(ms, 50));
     all.insert(all.end(), ms.begin(), ms.end());
     out << std::fixed << std::setprecision(3) << "  run " << run + 1 << "  threads "
         << scene.world().threadCount() << "  ms/frame p50 " << medians.back() << "  p95 "
-        << nearestRankPercentile(ms, 95) << "  p99 " << nearestRankPercentile(ms, 99) << "  mean "
+        << percentile(ms, 95) << "  p99 " << percentile(ms, 99) << "  mean "
         << std::accumulate(ms.begin(), ms.end(), 0.0) / double(ms.size()) << "  state hash 0x"
         << std::hex << hash << std::dec << "\n";
   }
   const double best = *std::min_element(medians.begin(), medians.end());
   const double worst = *std::max_element(medians.begin(), medians.end());
-  out << std::fixed << std::setprecision(3) << "  all runs  ms/frame p50 " << nearestRankPercentile(all, 50)
-      << "  p95 " << nearestRankPercentile(all, 95) << "  p99 " << nearestRankPercentile(all, 99)
+  out << std::fixed << std::setprecision(3) << "  all runs  ms/frame p50 " << percentile(all, 50)
+      << "  p95 " << percentile(all, 95) << "  p99 " << percentile(all, 99)
       << "\n  spread    slowest run median / fastest " << std::setprecision(2) << worst / best
       << "\n  determinism  " << (sameBits ? "every run ended with the same state hash"
                                           : "RUNS DIFFER: the state hashes are not equal")

@@ -5,7 +5,7 @@
 // export are measured apart or not at all, so the simulation figures mean the same with and
 // without them. Frame 1 is left out of the percentiles: it pays for first-touch page faults.
 #include "Commands.h"
-#include "FrameStatistics.h"
+#include <weft/threading/SampleStatistics.h>
 
 #include <weft/collision/SelfIntersectionCounter.h>
 #include <weft/engine/ObjWriter.h>
@@ -287,12 +287,12 @@ int runScene(const RunOptions& options, std::ostream& out) {
   const std::uint64_t hash = scene.world().stateHash();
   out << std::fixed << std::setprecision(3) << "\nReport\n"
       << "  frames         " << frames << " (" << std::setprecision(2) << wallSeconds << " s wall)\n"
-      << std::setprecision(3) << "  simulation ms  p50 " << nearestRankPercentile(steady, 50)
-      << "  p95 " << nearestRankPercentile(steady, 95) << "  p99 " << nearestRankPercentile(steady, 99)
-      << "  max " << nearestRankPercentile(steady, 100) << "\n";
+      << std::setprecision(3) << "  simulation ms  p50 " << percentile(steady, 50)
+      << "  p95 " << percentile(steady, 95) << "  p99 " << percentile(steady, 99)
+      << "  max " << percentile(steady, 100) << "\n";
   if (rendering) {
-    out << "  render ms      p50 " << nearestRankPercentile(steadyRender, 50) << "  p95 "
-        << nearestRankPercentile(steadyRender, 95) << "  p99 " << nearestRankPercentile(steadyRender, 99)
+    out << "  render ms      p50 " << percentile(steadyRender, 50) << "  p95 "
+        << percentile(steadyRender, 95) << "  p99 " << percentile(steadyRender, 99)
         << "  (draw + read back " << width << " x " << height << ")\n";
   }
   out << std::setprecision(1) << "  CG iterations  " << double(cgIterations) / double(frames) << " per frame\n"
@@ -315,10 +315,10 @@ int runScene(const RunOptions& options, std::ostream& out) {
         {"frames", frames},
         {"triangles", triangles},
         {"threads", scene.world().threadCount()},
-        {"sim_ms_p50", nearestRankPercentile(steady, 50)},
-        {"sim_ms_p95", nearestRankPercentile(steady, 95)},
-        {"sim_ms_p99", nearestRankPercentile(steady, 99)},
-        {"render_ms_p50", rendering ? nlohmann::json(nearestRankPercentile(steadyRender, 50)) : nlohmann::json(nullptr)},
+        {"sim_ms_p50", percentile(steady, 50)},
+        {"sim_ms_p95", percentile(steady, 95)},
+        {"sim_ms_p99", percentile(steady, 99)},
+        {"render_ms_p50", rendering ? nlohmann::json(percentile(steadyRender, 50)) : nlohmann::json(nullptr)},
         {"max_strain", maxStrain},
         {"max_contacts", maxContacts},
         {"max_self_contacts", maxSelfContacts},

@@ -250,6 +250,9 @@ class World {
   const ColliderSlot* find(ColliderId collider) const;
   ColliderSlot* find(ColliderId collider);
   void updateAttachedPins(Real frameDt);
+  // Fills m_colliderFrames from m_colliderStartMotions: each collider from its frame-start
+  // motion to the same (a cloth poses them per substep itself) or, untilNow, to where it is now.
+  void gatherColliderFrames(bool untilNow);
 
   WorldSettings m_settings;
   std::unique_ptr<TaskSystem> m_ownedTasks;  // when the caller gave none

@@ -1,4 +1,6 @@
-// Small statistics helpers for benchmark reports: percentiles and means of per-frame samples.
+// Statistics of per-frame samples (frame times, iteration counts) for the reports of the curtain
+// runner, the weft command line and the peer comparison: one nearest-rank percentile, so their
+// figures compare.
 #pragma once
 
 #include <algorithm>
