@@ -479,9 +479,9 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
   return HealthFailure::None;
 }
 
-HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic) const {
-  const Real strain = maxStrain();
-  if (strain > kDivergedStrain && strain > startStrain) return HealthFailure::Strain;
+HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic, Real endStrain,
+                                      Real endKinetic) const {
+  if (endStrain > kDivergedStrain && endStrain > startStrain) return HealthFailure::Strain;
   // The energy the frame could give the cloth: what it had (kinetic, and elastic: the reported
   // potential minus gravity's part, −Σ m g·x), the whole cloth thrown at the fastest driver's
   // speed (pins, collider surfaces, wind), a free fall through its own size, and the work of
@@ -516,7 +516,7 @@ HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic) const
   }
   const Real available = startKinetic + elastic + externalWork +
                          0.5 * totalMass * (driverSpeed * driverSpeed + 2 * gravity.norm() * size);
-  if (kineticEnergy() > kEnergyJumpFactor * available) return HealthFailure::EnergyJump;
+  if (endKinetic > kEnergyJumpFactor * available) return HealthFailure::EnergyJump;
   return HealthFailure::None;
 }
 
@@ -613,6 +613,8 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
       m_savedPositions = m_positions;
       m_savedVelocities = m_velocities;
       report.sleeping = true;
+      report.maxStrain = maxStrain();
+      report.kineticEnergy = kineticEnergy();
       return report;
     }
     m_sleeping = false;
@@ -657,12 +659,17 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
     HealthFailure failure = runSubsteps(t, frameDt, substeps, colliders, report);
     if (failure == HealthFailure::None) {
       WEFT_PROFILE_ZONE("health");
-      failure = checkFrameHealth(startStrain, startKinetic);
+      // Kept for the report too: World's statistics read them instead of measuring again.
+      report.maxStrain = maxStrain();
+      report.kineticEnergy = kineticEnergy();
+      failure = checkFrameHealth(startStrain, startKinetic, report.maxStrain, report.kineticEnergy);
     }
     if (failure == HealthFailure::None) break;
     report.healthFailure = failure;
     m_positions = m_savedPositions;
     m_velocities = m_savedVelocities;
+    report.maxStrain = startStrain;  // back where the frame started
+    report.kineticEnergy = startKinetic;
     m_integrator->reset();  // the failed attempt's Δv is no warm start
     report.status |= StepStatus::Unstable;
     if (attempt == kMaxRetries) {

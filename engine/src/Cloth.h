@@ -40,6 +40,8 @@ struct ClothFrameReport {
   IntegratorReport integrator;
   StepStatus status = StepStatus::Ok;
   HealthFailure healthFailure = HealthFailure::None;  ///< why the last failed attempt failed
+  Real maxStrain = 0;      ///< Cloth::maxStrain() at the end of the frame
+  Real kineticEnergy = 0;  ///< J, Cloth::kineticEnergy() at the end of the frame
 };
 
 class Cloth final : public DynamicSystem {
@@ -161,7 +163,9 @@ class Cloth final : public DynamicSystem {
   Vec3Array m_savedPositions, m_savedVelocities;
   Real m_frameStartPotential = 0;  // J, elastic + gravity at the frame start (first substep)
   // The end-of-attempt checks (strain, energy jump) against the frame start; see stepFrame().
-  HealthFailure checkFrameHealth(Real startStrain, Real startKinetic) const;
+  // Checks a stepped frame given the strain and kinetic energy at its start and end.
+  HealthFailure checkFrameHealth(Real startStrain, Real startKinetic, Real endStrain,
+                                 Real endKinetic) const;
 
   std::vector<Index> m_pinnedSorted;   // pinned vertices, increasing
   std::vector<char> m_pinnedMask;      // 1 for pinned vertices

@@ -462,8 +462,8 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.potentialEnergy += report.integrator.potentialEnergy;
     stats.assemblyMs += report.integrator.assemblyMs;
     stats.solveMs += report.integrator.solveMs;
-    stats.kineticEnergy += cloth.kineticEnergy();
-    stats.maxStrain = std::max(stats.maxStrain, cloth.maxStrain());
+    stats.kineticEnergy += report.kineticEnergy;
+    stats.maxStrain = std::max(stats.maxStrain, report.maxStrain);
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
   }
   std::size_t k = 0;
