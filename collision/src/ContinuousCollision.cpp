@@ -113,6 +113,22 @@ struct Moving {
 
 Moving operator-(const Moving& x, const Moving& y) { return {x.start - y.start, x.change - y.change}; }
 
+// The coplanarity cubic f(t) = (U × V) · W of three moving vectors, how far from zero it may
+// stay while they are within `tolerance` of coplanar (round-off included), and the size of the
+// configuration (|U| + |V| + |W| at their longest) that impact normals are judged against.
+struct Coplanarity {
+  detail::Cubic f;
+  Real slack;
+  Real scale;
+};
+
+Coplanarity coplanarity(const Moving& u, const Moving& v, const Moving& w, Real tolerance) {
+  const Real scaleU = u.maxNorm(), scaleV = v.maxNorm(), scaleW = w.maxNorm();
+  return {detail::tripleProductCubic(u.start, u.change, v.start, v.change, w.start, w.change),
+          tolerance * scaleU * scaleV + 32 * kRoundoff * scaleU * scaleV * scaleW,
+          scaleU + scaleV + scaleW};
+}
+
 // Times at which point `point` crosses the line of edge (from, to) inside the plane of normal
 // `normal`: roots of ((to − from) × (point − from)) · normal.
 void addCollinearityTimes(const Moving& from, const Moving& to, const Moving& point,
@@ -177,10 +193,7 @@ std::optional<VertexTriangleImpact> sweptVertexTriangle(const Vec3& vertexStart,
   const Moving u = b - a;
   const Moving v = c - a;
   const Moving w = p - a;
-  const Cubic f = detail::tripleProductCubic(u.start, u.change, v.start, v.change, w.start,
-                                             w.change);
-  const Real scaleU = u.maxNorm(), scaleV = v.maxNorm(), scaleW = w.maxNorm();
-  const Real slack = tolerance * scaleU * scaleV + 32 * kRoundoff * scaleU * scaleV * scaleW;
+  const auto [f, slack, scale] = coplanarity(u, v, w, tolerance);
 
   CandidateTimes candidates;
   if (f.magnitude() > slack) {
@@ -221,7 +234,7 @@ std::optional<VertexTriangleImpact> sweptVertexTriangle(const Vec3& vertexStart,
     const Vec3 relativeVelocity = w.change - (wb * u.change + wc * v.change);
     const Vec3 separationAtStart = w.start - (wb * u.start + wc * v.start);
     impact.normal = orientTowardFirst(normal, relativeVelocity, separationAtStart,
-                                      scaleU + scaleV + scaleW);
+                                      scale);
     return impact;
   }
   return std::nullopt;
@@ -241,10 +254,7 @@ std::optional<EdgeEdgeImpact> sweptEdgeEdge(const std::array<Vec3, 2>& firstStar
   const Moving v = q1 - q0;
   const Moving w = q0 - p0;
   const Moving wv{w.start + v.start, w.change + v.change};  // q1 − p0
-  const Cubic f = detail::tripleProductCubic(u.start, u.change, v.start, v.change, w.start,
-                                             w.change);
-  const Real scaleU = u.maxNorm(), scaleV = v.maxNorm(), scaleW = w.maxNorm();
-  const Real slack = tolerance * scaleU * scaleV + 32 * kRoundoff * scaleU * scaleV * scaleW;
+  const auto [f, slack, scale] = coplanarity(u, v, w, tolerance);
 
   CandidateTimes candidates;
   if (f.magnitude() > slack) {
@@ -320,7 +330,7 @@ std::optional<EdgeEdgeImpact> sweptEdgeEdge(const std::array<Vec3, 2>& firstStar
     const Vec3 relativeVelocity = s * u.change - (w.change + r * v.change);
     const Vec3 separationAtStart = s * u.start - (w.start + r * v.start);
     impact.normal = orientTowardFirst(normal, relativeVelocity, separationAtStart,
-                                      scaleU + scaleV + scaleW);
+                                      scale);
     return impact;
   }
   return std::nullopt;
