@@ -13,7 +13,10 @@
 //            frame steps 1/600 … 1/15 s, with the error against the 1/600 s run at every second.
 //
 // Timings are wall-clock on whatever machine runs it: compare ratios from one run, not absolute
-// numbers across machines.
+// numbers across machines. The soak also samples the process's CPU time per step and the PCG
+// iterations per step: on a machine whose load changes during the hour, CPU time per PCG
+// iteration is the drift measure that other jobs disturb least (run it with --threads 1 so CPU
+// time is the step's own work, not the pool's spinning).
 #include <weft/collision/SelfIntersectionCounter.h>
 #include <weft/scenes/Curtain.h>
 
@@ -26,6 +29,7 @@
 #include <fstream>
 #include <numeric>
 #include <string>
+#include <time.h>
 #include <unistd.h>
 #include <vector>
 
@@ -39,6 +43,13 @@ double residentMegabytes() {
   long size = 0, resident = 0;
   statm >> size >> resident;
   return double(resident) * double(sysconf(_SC_PAGESIZE)) / (1024.0 * 1024.0);
+}
+
+// CPU time of the whole process, ms.
+double processCpuMilliseconds() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return double(now.tv_sec) * 1e3 + double(now.tv_nsec) * 1e-6;
 }
 
 struct SoakOptions {
@@ -74,25 +85,26 @@ int runSoak(const SoakOptions& options) {
   const double frameDt = CurtainScene::kFrameDt;
   const long framesPerWindow = std::max(1L, std::lround(options.windowSeconds / frameDt));
   const long windows = std::max(1L, std::lround(options.minutes * 60 / options.windowSeconds));
-  std::vector<double> rss, stepMs;
+  std::vector<double> rss, stepMs, cpuMs, iterations;
   long retried = 0, rolledBack = 0, capped = 0, intersecting = 0;
   bool finite = true;
   std::ofstream csv;
   if (!options.csv.empty()) {
     csv.open(options.csv);
-    csv << "window,simulated_s,rss_mb,step_ms_mean,max_strain,kinetic_j\n";
+    csv << "window,simulated_s,rss_mb,step_ms_mean,cpu_ms_mean,cg_iterations_mean,max_strain,kinetic_j\n";
   }
   std::printf("soak: curtain in a %.1f m/s wind, script %s, %.1f simulated minutes, %ld windows of "
               "%.0f s, %d threads, self-collision %s\n", options.wind, options.script ? "repeated" : "off",
               options.minutes, windows, options.windowSeconds, world.threadCount(),
               options.selfCollision ? "on" : "off");
-  std::printf("%8s %10s %10s %12s %10s %12s\n", "window", "sim s", "RSS MB", "step ms", "strain",
-              "kinetic J");
+  std::printf("%8s %10s %10s %12s %10s %10s %10s %12s\n", "window", "sim s", "RSS MB", "step ms",
+              "cpu ms", "PCG it", "strain", "kinetic J");
   Vec3Array pinRest, targets(grid.columns);
   for (Index vertex : settings.pinnedVertices) pinRest.push_back(model->restPositions()[vertex]);
   long frameIndex = 0;
   for (long window = 0; window < windows; ++window) {
-    double milliseconds = 0, strain = 0;
+    double milliseconds = 0, cpuMilliseconds = 0, strain = 0;
+    long windowIterations = 0;
     for (long frame = 0; frame < framesPerWindow; ++frame) {
       if (options.script) {
         // The script's time, repeating every 10 s (it ends where it starts: open, sphere out).
@@ -103,9 +115,12 @@ int runSoak(const SoakOptions& options) {
         motionNow.linearVelocity = (CurtainScene::spherePosition(end) - motionNow.pose.position) / frameDt;
         (void)world.setColliderMotion(sphere, motionNow);
       }
+      const double cpuStart = processCpuMilliseconds();
       const auto start = std::chrono::steady_clock::now();
       const StepStatus status = world.step(frameDt);
       milliseconds += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+      cpuMilliseconds += processCpuMilliseconds() - cpuStart;
+      windowIterations += world.stats().cgIterations;
       retried += hasFlag(status, StepStatus::RetriedWithSmallerStep);
       rolledBack += hasFlag(status, StepStatus::RolledBack);
       capped += hasFlag(status, StepStatus::SolverNotConverged);
@@ -115,13 +130,16 @@ int runSoak(const SoakOptions& options) {
     if (options.checkIntersections) intersecting += counter.count(world.positions(cloth).value()) > 0;
     rss.push_back(residentMegabytes());
     stepMs.push_back(milliseconds / double(framesPerWindow));
+    cpuMs.push_back(cpuMilliseconds / double(framesPerWindow));
+    iterations.push_back(double(windowIterations) / double(framesPerWindow));
     const double simulated = world.time();
-    std::printf("%8ld %10.0f %10.1f %12.3f %10.4f %12.4g\n", window + 1, simulated, rss.back(),
-                stepMs.back(), strain, world.stats().kineticEnergy);
+    std::printf("%8ld %10.0f %10.1f %12.3f %10.3f %10.1f %10.4f %12.4g\n", window + 1, simulated,
+                rss.back(), stepMs.back(), cpuMs.back(), iterations.back(), strain,
+                world.stats().kineticEnergy);
     std::fflush(stdout);
     if (csv) {
       csv << window + 1 << ',' << simulated << ',' << rss.back() << ',' << stepMs.back() << ','
-          << strain << ',' << world.stats().kineticEnergy << '\n';
+          << cpuMs.back() << ',' << iterations.back() << ',' << strain << ',' << world.stats().kineticEnergy << '\n';
     }
   }
 
@@ -139,6 +157,19 @@ int runSoak(const SoakOptions& options) {
   std::printf("step time: first 10 %% %.3f ms, last 10 %% %.3f ms, ratio %.3f: %s\n", firstMs,
               lastMs, drift, std::abs(drift - 1) > 0.2 ? "DRIFTED (or the machine's load changed)"
                                                        : "no drift beyond 20 %");
+  // CPU time per PCG iteration: the work per step changes with what the cloth does (the script
+  // repeats, so it should not), and the CPU clock is the one other jobs disturb least.
+  const double firstCpuPerIteration = mean(cpuMs.begin(), cpuMs.begin() + tenth) /
+                                      std::max(1.0, mean(iterations.begin(), iterations.begin() + tenth));
+  const double lastCpuPerIteration = mean(cpuMs.end() - tenth, cpuMs.end()) /
+                                     std::max(1.0, mean(iterations.end() - tenth, iterations.end()));
+  const double cpuDrift = lastCpuPerIteration / firstCpuPerIteration;
+  std::printf("CPU time: first 10 %% %.3f ms/step, last 10 %% %.3f ms/step; per PCG iteration "
+              "ratio %.3f: %s\n", mean(cpuMs.begin(), cpuMs.begin() + tenth),
+              mean(cpuMs.end() - tenth, cpuMs.end()), cpuDrift,
+              std::abs(cpuDrift - 1) > 0.1 ? "DRIFTED" : "no drift beyond 10 %");
+  std::printf("PCG iterations per step: first 10 %% %.1f, last 10 %% %.1f\n",
+              mean(iterations.begin(), iterations.begin() + tenth), mean(iterations.end() - tenth, iterations.end()));
   std::printf("frames %ld: retried %ld, rolled back %ld, solver cap %ld (%.3f %%), state %s",
               frames, retried, rolledBack, capped, 100.0 * double(capped) / double(frames),
               finite ? "finite" : "NOT FINITE");
