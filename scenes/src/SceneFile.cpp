@@ -477,8 +477,17 @@ std::optional<PinScript> readPinScript(Reader& reader, const Json& object, const
   return script;
 }
 
+// A pin group's "attachTo", kept until the colliders are read.
+struct PendingAttachment {
+  std::size_t cloth = 0;  // index into SceneDescription::cloths
+  std::size_t group = 0;  // index into ClothDescription::pins
+  std::string colliderName;
+  std::string path;       // of the "attachTo" value
+};
+
 std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
-                                          const std::string& path, std::size_t index) {
+                                          const std::string& path, std::size_t index,
+                                          std::vector<PendingAttachment>& attachments) {
   if (!reader.expectObject(object, path, "a cloth")) return std::nullopt;
   reader.checkKeys(object, path,
                    {"name", "grid", "mesh", "translation", "rotation", "forceModel", "material",
@@ -559,7 +568,7 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
         const std::string here = child(child(path, "pins"), g);
         const Json& pin = (*pins)[g];
         if (!reader.expectObject(pin, here, "a pin group: vertices, row or column, and a script")) continue;
-        reader.checkKeys(pin, here, {"vertices", "row", "column", "script"});
+        reader.checkKeys(pin, here, {"vertices", "row", "column", "script", "attachTo"});
         PinGroup group;
         if (!readPinSelection(reader, pin, here, cloth, group.vertices)) continue;
         bool unique = true;
@@ -574,8 +583,18 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
         }
         if (!unique) continue;
         if (const Json* script = Reader::member(pin, "script")) {
+          if (Reader::member(pin, "attachTo")) {
+            reader.fail(child(here, "attachTo"), "a pin group either follows a script or rides on a collider; remove \"script\" or \"attachTo\"");
+            continue;
+          }
           group.script = readPinScript(reader, *script, child(here, "script"));
           if (!group.script) continue;
+        }
+        if (Reader::member(pin, "attachTo")) {
+          // The collider is looked up by name once the colliders are read (resolveAttachments).
+          std::string name;
+          if (!reader.readString(pin, here, "attachTo", name)) continue;
+          attachments.push_back({index, cloth.pins.size(), name, child(here, "attachTo")});
         }
         settings.pinnedVertices.insert(settings.pinnedVertices.end(), group.vertices.begin(), group.vertices.end());
         cloth.pins.push_back(std::move(group));
@@ -746,8 +765,66 @@ void readCamera(Reader& reader, const Json& object, const std::string& path, Sce
   if ((camera.eye - camera.target).norm() == 0) reader.fail(child(path, "eye"), "is at the target; move the eye away from it");
 }
 
+// "windScript": {"easing": ..., "keyframes": [{"time": s, "wind": [x, y, z]}]}. A keyframe that
+// leaves out "wind" holds the previous one's (the world's "wind" for the first); the start wind is
+// the first keyframe's.
+void readWindScript(Reader& reader, const Json& script, SceneDescription& scene) {
+  const std::string here = "/world/windScript";
+  if (!reader.expectObject(script, here, "{\"easing\": ..., \"keyframes\": [...]}")) return;
+  reader.checkKeys(script, here, {"easing", "keyframes"});
+  reader.readEasing(script, here, scene.windEasing);
+  const Json* keys = reader.array(script, here, "keyframes", true, "keyframes [{\"time\": s, \"wind\": [x, y, z]}]");
+  if (!keys) return;
+  if (keys->empty()) reader.fail(child(here, "keyframes"), "is empty; give at least one keyframe");
+  WindKeyframe previous{0, scene.wind};
+  for (std::size_t k = 0; k < keys->size() && !reader.full(); ++k) {
+    const std::string at = child(child(here, "keyframes"), k);
+    const Json& key = (*keys)[k];
+    if (!reader.expectObject(key, at, "a keyframe: time, wind")) continue;
+    reader.checkKeys(key, at, {"time", "wind"});
+    WindKeyframe frame = previous;
+    if (!Reader::member(key, "time")) reader.fail(child(at, "time"), "is missing; give the time in seconds");
+    if (reader.readReal(key, at, "time", frame.time, Range::NonNegative, "s") && k > 0 &&
+        Reader::member(key, "time") && !(frame.time > previous.time)) {
+      reader.fail(child(at, "time"), "is " + formatNumber(frame.time) +
+                                         " s; keyframe times must increase (the previous is " +
+                                         formatNumber(previous.time) + " s)");
+    }
+    reader.readVec3(key, at, "wind", frame.wind, "m/s");
+    scene.windKeyframes.push_back(frame);
+    previous = frame;
+  }
+  if (!scene.windKeyframes.empty()) scene.wind = scene.windKeyframes.front().wind;
+}
+
+// Names each "attachTo" to its collider, once both are read.
+void resolveAttachments(Reader& reader, const std::vector<PendingAttachment>& attachments,
+                        SceneDescription& scene) {
+  for (const PendingAttachment& attachment : attachments) {
+    // A cloth that failed to parse is missing from the list (and the scene is refused anyway).
+    if (attachment.cloth >= scene.cloths.size() ||
+        attachment.group >= scene.cloths[attachment.cloth].pins.size()) {
+      continue;
+    }
+    std::optional<std::size_t> found;
+    std::string names;
+    for (std::size_t k = 0; k < scene.colliders.size(); ++k) {
+      if (scene.colliders[k].name == attachment.colliderName && !found) found = k;
+      names += (names.empty() ? "\"" : ", \"") + scene.colliders[k].name + "\"";
+    }
+    if (!found) {
+      reader.fail(attachment.path, "names no collider: \"" + attachment.colliderName + "\"; " +
+                                       (names.empty() ? std::string("the scene has no colliders")
+                                                      : "give one of " + names));
+      continue;
+    }
+    scene.cloths[attachment.cloth].pins[attachment.group].attachedCollider = found;
+  }
+}
+
 SceneDescription readScene(Reader& reader, const Json& document) {
   SceneDescription scene;
+  std::vector<PendingAttachment> attachments;
   if (!document.is_object()) {
     reader.fail("", "a scene file must hold a JSON object, not " + typeName(document));
     return scene;
@@ -763,9 +840,10 @@ SceneDescription readScene(Reader& reader, const Json& document) {
   reader.readString(document, "", "description", scene.description);
   if (const Json* world = Reader::member(document, "world")) {
     if (reader.expectObject(*world, "/world", "gravity and wind")) {
-      reader.checkKeys(*world, "/world", {"gravity", "wind"});
+      reader.checkKeys(*world, "/world", {"gravity", "wind", "windScript"});
       reader.readVec3(*world, "/world", "gravity", scene.gravity, "m/s²");
       reader.readVec3(*world, "/world", "wind", scene.wind, "m/s");
+      if (const Json* script = Reader::member(*world, "windScript")) readWindScript(reader, *script, scene);
     }
   }
   if (const Json* run = Reader::member(document, "run")) {
@@ -788,7 +866,7 @@ SceneDescription readScene(Reader& reader, const Json& document) {
   if (const Json* cloths = reader.array(document, "", "cloths", true, "the cloths [{\"grid\": {...}}]")) {
     if (cloths->empty()) reader.fail("/cloths", "is empty; a scene needs at least one cloth");
     for (std::size_t k = 0; k < cloths->size() && !reader.full(); ++k) {
-      std::optional<ClothDescription> cloth = readCloth(reader, (*cloths)[k], child("/cloths", k), k);
+      std::optional<ClothDescription> cloth = readCloth(reader, (*cloths)[k], child("/cloths", k), k, attachments);
       if (cloth) scene.cloths.push_back(std::move(*cloth));
     }
   }
@@ -798,6 +876,7 @@ SceneDescription readScene(Reader& reader, const Json& document) {
       if (collider) scene.colliders.push_back(std::move(*collider));
     }
   }
+  resolveAttachments(reader, attachments, scene);
   return scene;
 }
 

@@ -73,6 +73,17 @@ Pose keyframePose(const ColliderDescription& collider, Real t) {
   return pose;
 }
 
+Vec3 windAt(const SceneDescription& scene, Real t) {
+  const std::vector<WindKeyframe>& keys = scene.windKeyframes;
+  if (keys.empty()) return scene.wind;
+  const std::ptrdiff_t segment = segmentAt(keys, t);
+  if (segment < 0) return keys.front().wind;
+  if (segment + 1 >= std::ptrdiff_t(keys.size())) return keys.back().wind;
+  const WindKeyframe& a = keys[segment];
+  const WindKeyframe& b = keys[segment + 1];
+  return interpolate(a.wind, b.wind, ease(scene.windEasing, (t - a.time) / (b.time - a.time)));
+}
+
 Result<ScriptedScene> ScriptedScene::create(SceneDescription description,
                                             const ScriptedSceneSettings& settings) {
   ScriptedScene scene;
@@ -128,6 +139,26 @@ Result<ScriptedScene> ScriptedScene::create(SceneDescription description,
     if (!state.ok()) return Error{"/cloths/" + std::to_string(k) + "/initialPleats: " + state.error().message};
   }
 
+  // Pins riding on colliders keep the offsets they have once the cloth is placed and pleated.
+  for (std::size_t k = 0; k < description.cloths.size(); ++k) {
+    const std::vector<PinGroup>& groups = description.cloths[k].pins;
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      if (!groups[g].attachedCollider) continue;
+      const std::size_t collider = *groups[g].attachedCollider;
+      if (collider >= scene.m_colliders.size()) {
+        return Error{"/cloths/" + std::to_string(k) + "/pins/" + std::to_string(g) +
+                     "/attachTo: names collider " + std::to_string(collider) + ", but the scene has " +
+                     std::to_string(scene.m_colliders.size())};
+      }
+      Status attached = scene.m_world->attachToCollider(scene.m_cloths[k], groups[g].vertices,
+                                                        scene.m_colliders[collider]);
+      if (!attached.ok()) {
+        return Error{"/cloths/" + std::to_string(k) + "/pins/" + std::to_string(g) + "/attachTo: " +
+                     attached.error().message};
+      }
+    }
+  }
+
   // Pin start positions: where the pins are once the cloth is placed (and pleated).
   for (std::size_t k = 0; k < description.cloths.size(); ++k) {
     const std::span<const Vec3> x = scene.m_world->positions(scene.m_cloths[k]).value();
@@ -162,6 +193,9 @@ StepStatus ScriptedScene::stepFrame() {
     if (!m_scripted[k]) continue;
     pinTargetsAt(k, endTime, m_targets);
     if (!m_world->setPinTargets(m_cloths[k], m_targets).ok()) refused = StepStatus::InvalidInput;
+  }
+  if (!m_description.windKeyframes.empty()) {
+    if (!m_world->setWind(windAt(m_description, endTime)).ok()) refused = StepStatus::InvalidInput;
   }
   for (std::size_t k = 0; k < m_colliders.size(); ++k) {
     const ColliderDescription& collider = m_description.colliders[k];

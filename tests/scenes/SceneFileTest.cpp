@@ -189,6 +189,16 @@ INSTANTIATE_TEST_SUITE_P(
                  "/colliders/0/obj", "cannot read OBJ file"},
         BadScene{"BadResolution", R"({"version": 1, "camera": {"resolution": [0, 720]}, "cloths": [{"grid": {}}]})",
                  "/camera/resolution/0", "from 16 to 16384"},
+        BadScene{"AttachToUnknownCollider", R"({"version": 1, "cloths": [{"grid": {"columns": 3, "rows": 3}, "pins": [{"row": 2, "attachTo": "rod"}]}], "colliders": [{"type": "sphere", "name": "ball", "radius": 1}]})",
+                 "/cloths/0/pins/0/attachTo", "give one of \"ball\""},
+        BadScene{"AttachToWithoutColliders", CLOTH(R"(, "pins": [{"row": 2, "attachTo": "rod"}])"),
+                 "/cloths/0/pins/0/attachTo", "the scene has no colliders"},
+        BadScene{"AttachToAndScript", R"({"version": 1, "cloths": [{"grid": {"columns": 3, "rows": 3}, "pins": [{"row": 2, "attachTo": "ball", "script": {"keyframes": [{"time": 0}]}}]}], "colliders": [{"type": "sphere", "name": "ball", "radius": 1}]})",
+                 "/cloths/0/pins/0/attachTo", "remove \"script\" or \"attachTo\""},
+        BadScene{"WindKeyframesGoBack", R"({"version": 1, "world": {"windScript": {"keyframes": [{"time": 1, "wind": [0, 0, 1]}, {"time": 1}]}}, "cloths": [{"grid": {}}]})",
+                 "/world/windScript/keyframes/1/time", "must increase"},
+        BadScene{"WindNotAVector", R"({"version": 1, "world": {"windScript": {"keyframes": [{"time": 0, "wind": 3}]}}, "cloths": [{"grid": {}}]})",
+                 "/world/windScript/keyframes/0/wind", "three numbers"},
         BadScene{"EscapedKey", R"({"version": 1, "a/b~c": 1, "cloths": [{"grid": {}}]})", "/a~1b~0c", "unknown key"}),
     [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
 

@@ -131,6 +131,52 @@ TEST(ScriptedScene, PinScriptsMoveTheirGroupAndOtherPinsHold) {
   EXPECT_GT((x[0] - freeStart).norm(), 0.01);  // the free corner swings
 }
 
+TEST(ScriptedScene, PinsAttachedToAColliderRideOnIt) {
+  // A square hanging from a rod (a capsule turned to lie along x) that slides 0.4 m along +x in
+  // 1 s: the top row keeps its offsets in the rod's frame, so it moves exactly as far. (Turning
+  // bodies are covered by the World API's own tests, AttachmentAndForcesTest.)
+  ScriptedScene scene = build(R"({"version": 1,
+      "cloths": [{"grid": {"columns": 5, "rows": 5, "width": 0.4, "height": 0.4, "origin": [-0.2, 0.6, 0]},
+                  "selfCollision": false, "pins": [{"row": 4, "attachTo": "rod"}]}],
+      "colliders": [{"type": "capsule", "name": "rod", "radius": 0.01, "halfLength": 0.3,
+                     "motion": {"keyframes": [
+                        {"time": 0, "position": [0, 1.02, 0], "rotation": {"axis": [0, 0, 1], "angleDegrees": 90}},
+                        {"time": 1, "position": [0.4, 1.02, 0]}]}}]})");
+  ASSERT_EQ(scene.world().attachedVertexCount(scene.cloth(0)).value(), 5u);
+  const Vec3Array start(scene.world().positions(scene.cloth(0)).value().begin(),
+                        scene.world().positions(scene.cloth(0)).value().end());
+  for (int frame = 0; frame < 60; ++frame) ASSERT_EQ(scene.stepFrame(), StepStatus::Ok);
+  const std::span<const Vec3> x = scene.world().positions(scene.cloth(0)).value();
+  for (Index column = 0; column < 5; ++column) {
+    const Index vertex = 20 + column;
+    EXPECT_NEAR((x[vertex] - (start[vertex] + Vec3(0.4, 0, 0))).norm(), 0, 1e-9) << "vertex " << vertex;
+  }
+  EXPECT_LT(x[0].y(), start[0].y());  // the free bottom row hangs on
+}
+
+TEST(ScriptedScene, WindFollowsItsKeyframes) {
+  const char* json = R"({"version": 1, "world": {"wind": [0, 0, 9], "windScript": {"keyframes": [
+          {"time": 0.5, "wind": [0, 0, 0]}, {"time": 1.5, "wind": [0, 0, 6]}]}},
+      "cloths": [{"grid": {"columns": 5, "rows": 5, "width": 0.4, "height": 0.4, "origin": [-0.2, 0.6, 0]},
+                  "selfCollision": false, "pins": [{"row": 4}]}]})";
+  Result<SceneDescription> description = loadSceneText(json);
+  ASSERT_TRUE(description.ok()) << description.error().message;
+  // The first keyframe's wind is the start wind (it overrides "wind"), held until 0.5 s.
+  EXPECT_EQ(description->wind, Vec3::Zero());
+  EXPECT_EQ(windAt(description.value(), 0.25), Vec3::Zero());
+  EXPECT_NEAR((windAt(description.value(), 1.0) - Vec3(0, 0, 3)).norm(), 0, 1e-12);
+  EXPECT_EQ(windAt(description.value(), 2.0), Vec3(0, 0, 6));
+
+  ScriptedScene scene = build(json);
+  for (int frame = 0; frame < 30; ++frame) ASSERT_EQ(scene.stepFrame(), StepStatus::Ok);
+  EXPECT_EQ(scene.world().wind(), Vec3::Zero());  // still calm at 0.5 s
+  // No wind: the hanging square stays in its plane.
+  EXPECT_NEAR(scene.world().positions(scene.cloth(0)).value()[0].z(), 0, 1e-9);
+  for (int frame = 30; frame < 120; ++frame) ASSERT_EQ(scene.stepFrame(), StepStatus::Ok);
+  EXPECT_EQ(scene.world().wind(), Vec3(0, 0, 6));
+  EXPECT_GT(scene.world().positions(scene.cloth(0)).value()[0].z(), 0.02);  // blown downwind
+}
+
 TEST(ScriptedScene, ScaleAndRotationAreAboutTheAnchor) {
   PinScript script;
   script.anchor = Vec3(1, 0, 0);

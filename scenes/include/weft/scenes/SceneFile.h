@@ -16,9 +16,12 @@
 // smoothstep. Before the first keyframe a track holds the first value, after the last one the last.
 // The format itself is documented key by key in scenes/data/README.md.
 //
-// Not in the format (the World API has no such thing yet): vertices attached to a moving collider
-// (pins follow their own scripts instead), releasing pins during a run, per-vertex initial
-// velocities.
+// A pin group can instead ride on a collider ("attachTo", World::attachToCollider()): the
+// collider is named, and names are resolved once cloths and colliders are both read. The wind can
+// follow a keyframe track ("windScript"), applied through World::setWind() each frame.
+//
+// Not in the format (the World API has no such thing yet): releasing pins during a run,
+// per-vertex initial velocities.
 #pragma once
 
 #include <weft/Math.h>
@@ -59,10 +62,14 @@ struct PinScript {
   bool rotates = false;            ///< some keyframe has a rotation (else rotation is skipped)
 };
 
-/// A set of pinned vertices and how they move (held where they start when there is no script).
+/// A set of pinned vertices and how they move (held where they start when there is neither a
+/// script nor a collider to ride on).
 struct PinGroup {
   std::vector<Index> vertices;     ///< into the cloth's model, each pinned once in the cloth
   std::optional<PinScript> script; ///< none: the pins stay at their start positions
+  /// Index into SceneDescription::colliders of the collider the pins ride on (World::
+  /// attachToCollider(): they keep their start offsets in its body frame), or none.
+  std::optional<std::size_t> attachedCollider;
 };
 
 /// Gentle sinusoidal pleats a grid cloth starts with (the curtain's initial waviness): the
@@ -102,6 +109,12 @@ struct ColliderDescription {
   bool rotates = false;            ///< some keyframe turns it (else its angular velocity is kept)
 };
 
+/// Keyframe of the wind (the air's velocity, felt through the material's airDrag).
+struct WindKeyframe {
+  Real time = 0;            ///< s
+  Vec3 wind = Vec3::Zero(); ///< m/s
+};
+
 /// Where the picture of `weft run --render` is taken from (weft/render CameraSettings' fields).
 struct SceneCamera {
   Vec3 eye{0.0, 1.25, 3.2};        ///< m
@@ -117,7 +130,9 @@ struct SceneDescription {
   std::string name;           ///< "name" of the file, else the file's stem
   std::string description;    ///< free text
   Vec3 gravity{0.0, -9.81, 0.0};  ///< m/s²
-  Vec3 wind{0.0, 0.0, 0.0};       ///< m/s
+  Vec3 wind{0.0, 0.0, 0.0};       ///< m/s (the first keyframe's when windKeyframes has any)
+  Easing windEasing = Easing::Linear;      ///< between wind keyframes
+  std::vector<WindKeyframe> windKeyframes; ///< empty: the wind stays `wind`
   Index frames = 600;             ///< frames of a full run
   Real frameDt = 1.0 / 60.0;      ///< s per frame
   SceneCamera camera;

@@ -1,7 +1,8 @@
 // ScriptedScene: a World built from a SceneDescription, stepped frame by frame with its scripts.
 //
 // Every frame, before World::step(), each scripted pin group gets the targets its keyframes give
-// at the frame's end time, and each keyframed collider gets the velocities that carry it from
+// at the frame's end time, the wind (if it has keyframes) the value at that time, and each
+// keyframed collider gets the velocities that carry it from
 // where it is to where its keyframes put it at that time (the way CurtainScene moves its sphere):
 // the world moves colliders with their velocities during the step, so the pose follows the track
 // without a jump. Colliders without keyframes keep their constant velocities.
@@ -30,11 +31,14 @@ Real ease(Easing easing, Real fraction);
 Vec3 pinTarget(const PinScript& script, const Vec3& start, Real t);
 /// Where a collider's keyframes put it at time `t` (s); keyframes must not be empty.
 Pose keyframePose(const ColliderDescription& collider, Real t);
+/// The wind (m/s) the scene's wind keyframes give at time `t` (s); `wind` when it has none.
+Vec3 windAt(const SceneDescription& scene, Real t);
 
 /// A World built from a scene description, plus the scripts that drive it.
 class ScriptedScene {
  public:
-  /// Builds the world (cloths, then colliders, then initial pleats). Errors name the cloth or
+  /// Builds the world (cloths, then colliders, then initial pleats, then pins riding on
+  /// colliders, which keep the offsets they have after the pleats). Errors name the cloth or
   /// collider by its JSON path and carry the engine's message.
   static Result<ScriptedScene> create(SceneDescription description,
                                       const ScriptedSceneSettings& settings = {});
