@@ -24,8 +24,8 @@ TEST(SceneFile, EveryShippedSceneLoadsBuildsAndSteps) {
     if (entry.path().extension() == ".json") names.push_back(entry.path().stem().string());
   }
   std::sort(names.begin(), names.end());
-  // The curtain and the shared scenes of the collision issue.
-  EXPECT_EQ(names, (std::vector<std::string>{"curtain", "floor-fold", "projectile",
+  // The curtain, the shared scenes of the collision issue, and the banner (attachments, wind).
+  EXPECT_EQ(names, (std::vector<std::string>{"banner", "curtain", "floor-fold", "projectile",
                                              "rotating-sphere", "sphere-drop", "two-layers"}));
   for (const std::string& name : names) {
     SCOPED_TRACE(name);
