@@ -42,6 +42,8 @@ void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to
                                       bool, std::vector<TrianglePair>& pairs) {
   WEFT_PROFILE_ZONE("broad phase");
   m_bvh.refit(from, to, inflate, m_tasks);
+  m_refitCounts.refitNodes += m_bvh.lastRefitCounts().refitNodes;
+  m_refitCounts.skippedNodes += m_bvh.lastRefitCounts().skippedNodes;
   if (m_tasks && m_workerPairs) {
     m_bvh.querySelf(pairs, *m_tasks, *m_workerPairs);
     // Which worker finds which pairs depends on scheduling, so a worker's list may need any
@@ -54,6 +56,13 @@ void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to
   } else {
     m_bvh.querySelf(pairs);
   }
+}
+
+void SelfCollision::setRefitSkipping(Real motion, Real thickness) {
+  // The resolver refits the tree twice a substep with different inflations: by the thickness
+  // (proximity at the step start) and by ~2 µm (the swept test). A leaf box inflated by the
+  // margin must hold both without a refit, so the margin is the thickness plus the motion allowed.
+  m_bvh.setRefitMargin(motion < 0 ? Real(-1) : thickness + motion);
 }
 
 SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real thickness,

@@ -36,11 +36,23 @@ class SelfCollision final : public ContactResolver {
                               const std::vector<Real>& inverseMasses, Vec3Array& x, Vec3Array& v,
                               std::span<const ColliderFrame> colliders = {});
 
+  /// Lets the BVH keep the boxes of parts that moved less than `motion` (m) since their last
+  /// refit (Bvh::setRefitMargin; the queries, hence the results, do not change). Negative:
+  /// refit every box every time. `thickness` is the cloth's contact thickness (m).
+  void setRefitSkipping(Real motion, Real thickness);
+  /// BVH nodes recomputed and kept by the refits since the last call; resets the counts.
+  Bvh::RefitCounts takeRefitCounts() {
+    const Bvh::RefitCounts counts = m_refitCounts;
+    m_refitCounts = {};
+    return counts;
+  }
+
  private:
   void findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate, bool proximity,
                          std::vector<TrianglePair>& pairs) override;
 
   Bvh m_bvh;
+  Bvh::RefitCounts m_refitCounts;  // summed over refits since takeRefitCounts()
   std::unique_ptr<PerWorker<std::vector<TrianglePair>>> m_workerPairs;  // with m_tasks
 };
 
