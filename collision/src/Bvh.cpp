@@ -183,6 +183,11 @@ void Bvh::refitTriangles(std::span<const Vec3> oldPositions, std::span<const Vec
 }
 
 void Bvh::refitNodes(TaskSystem* tasks) {
+  constexpr std::uint8_t kRecomputed = 1, kChanged = 2;
+  // Sized with the tree: build() refits once, so this allocates at build time only.
+  if (m_nodeRefitFlags.size() != m_nodes.size()) m_nodeRefitFlags.assign(m_nodes.size(), 0);
+  const bool refitAll = !(m_refitMargin >= 0);  // negative or NaN: the full refit
+  const Real margin = refitAll ? Real(0) : m_refitMargin;
   // Deepest level first: a node reads only its children (next level) or its slots.
   for (Index levelIndex = levelCount(); levelIndex-- > 0;) {
     const Index levelBegin = m_levelBegins[levelIndex];
@@ -190,20 +195,45 @@ void Bvh::refitNodes(TaskSystem* tasks) {
     detail::forEachBlock(tasks, levelSize, kRefitGrain, [&](Index begin, Index end, int) {
       for (Index n = levelBegin + begin; n < levelBegin + end; ++n) {
         Node& node = m_nodes[n];
+        std::uint8_t flags = 0;
         if (node.isLeaf()) {
           Aabb box = m_slotBounds[node.first];
           for (Index slot = node.first + 1; slot < node.first + node.count; ++slot) {
             box.expand(m_slotBounds[slot]);
           }
-          node.bounds = box;
-        } else {
+          if (refitAll) {
+            node.bounds = box;
+            flags = kRecomputed | kChanged;
+          } else {
+            // Keep the box while it holds the triangles and is at most 2m too large on any side.
+            Aabb loosest = box;
+            loosest.inflate(2 * margin);
+            const bool holds = (node.bounds.min.array() <= box.min.array()).all() &&
+                               (node.bounds.max.array() >= box.max.array()).all();
+            const bool tightEnough = (loosest.min.array() <= node.bounds.min.array()).all() &&
+                                     (loosest.max.array() >= node.bounds.max.array()).all();
+            if (!holds || !tightEnough) {
+              box.inflate(margin);
+              flags = kRecomputed | (box == node.bounds ? 0 : kChanged);
+              node.bounds = box;
+            }
+          }
+        } else if (refitAll || (m_nodeRefitFlags[node.first] & kChanged) ||
+                   (m_nodeRefitFlags[node.first + 1] & kChanged)) {
           Aabb box = m_nodes[node.first].bounds;
           box.expand(m_nodes[node.first + 1].bounds);
+          flags = kRecomputed | (refitAll || !(box == node.bounds) ? kChanged : 0);
           node.bounds = box;
         }
+        m_nodeRefitFlags[n] = flags;
       }
     });
   }
+  // Counted serially after the levels: an integer count has one value whatever the order.
+  Index recomputed = 0;
+  for (std::uint8_t flags : m_nodeRefitFlags) recomputed += flags & kRecomputed;
+  m_lastRefit.refitNodes = recomputed;
+  m_lastRefit.skippedNodes = Index(m_nodes.size()) - recomputed;
 }
 
 bool Bvh::slotsShareVertex(Index slotA, Index slotB) const {

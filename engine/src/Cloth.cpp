@@ -16,6 +16,13 @@ namespace {
 constexpr Real kExplicitGrowthPerStep = 1e-6;
 // Safety factor on the stable-step estimate (it is an upper bound of ω, but at the rest state).
 constexpr Real kStableStepSafety = 0.9;
+// How far (in contact thicknesses) the triangles under a self-collision BVH leaf may move before
+// the leaf's box is refit. Larger skips more refits of a slowly moving cloth and makes leaf boxes
+// looser (the self query prunes less; its results never change). 2 % of the thickness (60 µm on
+// the curtain) is far above the creep of cloth at rest and far below anything that loosens the
+// boxes measurably: on a strip folded on the floor it keeps 57 % of the nodes per frame against
+// 58 % for half a thickness, and half a thickness was measured no faster overall.
+constexpr Real kBvhRefitMotionPerThickness = 0.02;
 // A vertex faster than this (m/s) means the integration diverged: no cloth motion comes near
 // it (a 250 m/s projectile drags cloth at 250 m/s), while a blown-up explicit step passes it
 // within a few substeps.
@@ -179,11 +186,7 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
                                   world.gravity, world.wind, StiffnessMode::Definite,
                                   world.skipUnneededStages},
                std::move(masses), tasks) {
-  const std::vector<std::array<Index, 2>> pairs = m_forces.coupledPairs();
-  m_matrix.build(m_model->vertexCount(), pairs);
-  m_forces.bindMatrix(m_matrix);
   m_integrator = Integrator::create(settings.solver.integrator, settings.solver);
-
   const Index n = m_model->vertexCount();
   m_positions.resize(n);
   for (Index i = 0; i < n; ++i) {
@@ -204,6 +207,7 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   }
   m_pinnedMask.assign(n, 0);
   for (Index p : pins) m_pinnedMask[p] = 1;
+  buildSystemRows();
   m_pinStart.resize(pins.size());
   for (std::size_t k = 0; k < pins.size(); ++k) m_pinStart[k] = m_positions[pins[k]];
   m_pinEnd = m_pinStart;
@@ -214,9 +218,35 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   if (settings.selfCollision) {
     m_selfCollision = std::make_unique<SelfCollision>(*m_model, tasks);
     m_foldCulling = std::make_unique<FoldCulling>(*m_model);
+    // Parts of the cloth that moved less than this since their boxes were last refit keep them
+    // (the self-collision results are the same bits either way; see Bvh.h).
+    m_selfCollision->setRefitSkipping(
+        world.skipUnneededStages ? kBvhRefitMotionPerThickness * settings.material.thickness : -1);
   }
   m_skipStages = world.skipUnneededStages;
   estimateStiffestMode();
+}
+
+void Cloth::buildSystemRows() {
+  // Pinned vertices leave the implicit system when asked (and when the integrator has one);
+  // explicit integrators only read forces, which cover every vertex either way.
+  const Index n = m_model->vertexCount();
+  const bool remove = m_settings.solver.removePinnedVertices &&
+                      m_settings.solver.integrator == IntegratorKind::ImplicitEuler;
+  m_freeVertexMap.build(n, remove ? std::span<const Index>(m_pinnedSorted) : std::span<const Index>());
+  const std::vector<std::array<Index, 2>> pairs = m_forces.coupledPairs();
+  std::vector<std::array<Index, 2>> rowPairs;
+  rowPairs.reserve(pairs.size());
+  for (const auto& [a, b] : pairs) {
+    const Index rowA = m_freeVertexMap.row(a), rowB = m_freeVertexMap.row(b);
+    if (rowA != kInvalidIndex && rowB != kInvalidIndex) rowPairs.push_back({rowA, rowB});
+  }
+  m_matrix.build(m_freeVertexMap.rowCount(), rowPairs);
+  m_pinnedCoupling.build(m_freeVertexMap, pairs);
+  m_forces.bindMatrix(m_matrix, m_freeVertexMap, m_pinnedCoupling);
+  m_contactFilter.resize(m_freeVertexMap.isIdentity() ? 0 : n);
+  m_contactRows.clear();
+  m_contactRows.reserve(m_freeVertexMap.rowCount());
 }
 
 void Cloth::estimateStiffestMode() {
@@ -226,17 +256,20 @@ void Cloth::estimateStiffestMode() {
   const Index n = vertexCount();
   Vec3Array f, product, zero(n, Vec3::Zero());
   BlockSparseMatrix plus = m_matrix, minus = m_matrix;
-  m_forces.assemble(m_positions, zero, 1.0, plus, f, zero, product);
-  m_forces.assemble(m_positions, zero, -1.0, minus, f, zero, product);
+  PinnedCoupling coupling = m_pinnedCoupling;  // written by the assembly, not read here
+  m_forces.assemble(m_positions, zero, 1.0, plus, f, zero, product, &coupling);
+  m_forces.assemble(m_positions, zero, -1.0, minus, f, zero, product, &coupling);
   std::vector<bool> pinned(n, false);
   for (Index p : m_pinnedSorted) pinned[p] = true;
   const std::vector<Real>& mass = masses();
   Real omegaSquared = 0, dampingRate = 0;
-  for (Index row = 0; row < n; ++row) {
+  // Rows and columns of the system are vertices of m_freeVertexMap (pins may have none).
+  for (Index systemRow = 0; systemRow < plus.blockRows(); ++systemRow) {
+    const Index row = m_freeVertexMap.vertex(systemRow);
     if (pinned[row]) continue;
     Real stiffnessSum = 0, dampingSum = 0;
-    for (Index slot = plus.rowBegin(row); slot < plus.rowEnd(row); ++slot) {
-      const Index column = plus.column(slot);
+    for (Index slot = plus.rowBegin(systemRow); slot < plus.rowEnd(systemRow); ++slot) {
+      const Index column = m_freeVertexMap.vertex(plus.column(slot));
       if (pinned[column]) continue;
       const Mat3 massBlock = column == row ? Mat3(mass[row] * Mat3::Identity()) : Mat3::Zero();
       const Mat3 stiffness = massBlock - 0.5 * (plus.block(slot) + minus.block(slot));
@@ -283,7 +316,8 @@ Real Cloth::linearize(const Vec3Array& x, const Vec3Array& v, Real, Real h, Vec3
                       const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) {
   m_stages.bendingAssemblies += m_forces.evaluatesBending();
   m_stages.dampingJacobians += m_forces.formsDampingJacobians();
-  return m_forces.assemble(x, v, h, m_matrix, f, velocityForProduct, stiffnessTimesVelocity);
+  return m_forces.assemble(x, v, h, m_matrix, f, velocityForProduct, stiffnessTimesVelocity,
+                          &m_pinnedCoupling);
 }
 
 void Cloth::applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const {
@@ -404,8 +438,26 @@ void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
     }
   }
   selectNearColliders(m_colliders, predicted, nullptr);
+  if (m_freeVertexMap.isIdentity()) {
+    m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
+                                 m_pinnedMask, filter);
+    return;
+  }
+  // Pins are removed from the solve: gather the contacts by vertex, then copy them (bit for bit)
+  // into the rows of the solve's filter. Pinned vertices are never constrained, so every
+  // constrained vertex has a row.
   m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
-                               m_pinnedMask, filter);
+                               m_pinnedMask, m_contactFilter);
+  for (Index row : m_contactRows) filter.setFree(row);
+  m_contactRows.clear();
+  if (m_contactFilter.constrainedVertexCount() == 0) return;
+  for (Index i = 0; i < vertexCount(); ++i) {
+    if (m_contactFilter.kind(i) == ConstraintKind::Free) continue;
+    const Index row = m_freeVertexMap.row(i);
+    if (row == kInvalidIndex) continue;
+    filter.copyConstraint(row, m_contactFilter, i);
+    m_contactRows.push_back(row);
+  }
 }
 
 HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
@@ -455,6 +507,9 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
       report.selfCollision.impacts += self.impacts;
       report.selfCollision.impactZones += self.impactZones;
       report.selfCollision.frozenVertices += self.frozenVertices;
+      const Bvh::RefitCounts refits = m_selfCollision->takeRefitCounts();
+      m_stages.bvhNodesRefit += refits.refitNodes;
+      m_stages.bvhNodesSkipped += refits.skippedNodes;
     }
     report.integrator.linearSolves += substepReport.linearSolves;
     report.integrator.cgIterations += substepReport.cgIterations;
@@ -464,6 +519,7 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
     if (substep == 0) m_frameStartPotential = substepReport.potentialEnergy;
     report.integrator.assemblyMs += substepReport.assemblyMs;
     report.integrator.solveMs += substepReport.solveMs;
+    report.integrator.solvedUnknowns = substepReport.solvedUnknowns;
     // A cheap health check each substep: a NaN spreads through the whole mesh within one solve,
     // and a diverging explicit method passes any physical speed within a few substeps.
     WEFT_PROFILE_ZONE("health");

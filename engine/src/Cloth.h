@@ -11,6 +11,9 @@
 #include "SelfCollision.h"
 #include "integrators/Integrator.h"
 #include "solver/BlockSparseMatrix.h"
+#include "solver/FreeVertexMap.h"
+#include "solver/PinnedCoupling.h"
+#include "solver/VertexFilter.h"
 
 #include <weft/collision/Aabb.h>
 #include <weft/engine/World.h>
@@ -27,6 +30,8 @@ struct ClothStageCounters {
   Index selfCollisionSkipped = 0;
   Index bendingAssemblies = 0;
   Index dampingJacobians = 0;
+  Index bvhNodesRefit = 0;
+  Index bvhNodesSkipped = 0;
 };
 
 /// Result of advancing one cloth by one frame.
@@ -58,6 +63,10 @@ class Cloth final : public DynamicSystem {
   Real linearize(const Vec3Array& x, const Vec3Array& v, Real t, Real h, Vec3Array& f,
                  const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) override;
   const BlockSparseMatrix& systemMatrix() const override { return m_matrix; }
+  const FreeVertexMap* freeVertexMap() const override { return &m_freeVertexMap; }
+  void subtractPrescribedCoupling(const Vec3Array& deltaV, Vec3Array& rows) const override {
+    m_pinnedCoupling.subtractProduct(deltaV, rows);
+  }
   std::span<const Index> prescribedVertices() const override { return m_pinnedSorted; }
   void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const override;
   TaskSystem* taskSystem() override { return m_tasks; }
@@ -135,6 +144,9 @@ class Cloth final : public DynamicSystem {
   Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,
         const WorldSettings& world, std::vector<Real> masses, TaskSystem* tasks);
   void estimateStiffestMode();
+  // Builds the implicit system's rows (m_freeVertexMap), matrix pattern and pin coupling from the
+  // pin set; allocates, so it runs when the pin set is set (creation), never per step.
+  void buildSystemRows();
   // Runs `substeps` substeps of the frame; the failed check when the state became non-finite or
   // a vertex too fast (checked every substep), None otherwise.
   HealthFailure runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
@@ -154,7 +166,14 @@ class Cloth final : public DynamicSystem {
   TaskSystem* m_tasks;
   ClothSettings m_settings;
   ClothForces m_forces;
-  BlockSparseMatrix m_matrix;
+  BlockSparseMatrix m_matrix;         // rows: m_freeVertexMap
+  // Rows of the implicit system: the free vertices (pins removed, SolverSettings::
+  // removePinnedVertices) or every vertex; built with the pin set, at creation.
+  FreeVertexMap m_freeVertexMap;
+  PinnedCoupling m_pinnedCoupling;    // A(free row, pinned vertex), assembled with m_matrix
+  // Contacts gathered by vertex, renumbered into the solve's rows when pins are removed.
+  VertexFilter m_contactFilter;
+  std::vector<Index> m_contactRows;   // rows constrained in the solve's filter last step
   std::unique_ptr<Integrator> m_integrator;
 
   Vec3Array m_positions, m_velocities, m_normals;

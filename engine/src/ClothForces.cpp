@@ -22,6 +22,15 @@ struct ClothForces::Pass {
   const Vec3Array* velocityForProduct = nullptr;
   Vec3Array* stiffnessTimesVelocity = nullptr;
   bool damping = true;  // element velocity Jacobians are non-zero
+  PinnedCoupling* coupling = nullptr;
+  Index couplingBase = kInvalidIndex;
+
+  // The block a precomputed slot names, or null for a row that is not assembled (removed vertex).
+  Mat3* blockAt(Index slot) const {
+    if (slot < couplingBase) return &matrix->block(slot);
+    if (slot == kInvalidIndex || !coupling) return nullptr;
+    return &coupling->block(slot - couplingBase);
+  }
 };
 
 namespace {
@@ -208,25 +217,47 @@ std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
 }
 
 void ClothForces::bindMatrix(const BlockSparseMatrix& matrix) {
-  auto bind = [&matrix](auto& element) {
+  FreeVertexMap identity;
+  identity.build(Index(m_masses.size()), {});
+  bindMatrix(matrix, identity, PinnedCoupling{});
+}
+
+void ClothForces::bindMatrix(const BlockSparseMatrix& matrix, const FreeVertexMap& map,
+                             const PinnedCoupling& coupling) {
+  assert(matrix.blockRows() == map.rowCount() && "bindMatrix: matrix rows must be map.rowCount()");
+  m_couplingBase = matrix.blockCount();
+  // Slot of block (row vertex, column vertex): matrix, coupling (offset) or none.
+  const auto slotOf = [&](Index rowVertex, Index columnVertex) {
+    const Index row = map.row(rowVertex);
+    if (row == kInvalidIndex) return kInvalidIndex;
+    const Index column = map.row(columnVertex);
+    if (column != kInvalidIndex) {
+      const Index slot = matrix.slot(row, column);
+      assert(slot != kInvalidIndex && "matrix built without coupledPairs()");
+      return slot;
+    }
+    const Index slot = coupling.slot(row, columnVertex);
+    assert(slot != kInvalidIndex && "PinnedCoupling built without coupledPairs()");
+    return slot == kInvalidIndex ? kInvalidIndex : m_couplingBase + slot;
+  };
+  auto bind = [&](auto& element) {
     const int n = static_cast<int>(element.vertices.size());
     for (int a = 0; a < n; ++a)
-      for (int b = 0; b < n; ++b) {
-        element.slots[a * n + b] = matrix.slot(element.vertices[a], element.vertices[b]);
-        assert(element.slots[a * n + b] != kInvalidIndex && "matrix built without coupledPairs()");
-      }
+      for (int b = 0; b < n; ++b)
+        element.slots[a * n + b] = slotOf(element.vertices[a], element.vertices[b]);
   };
   for (auto& element : m_triangles) bind(element);
   for (auto& element : m_hinges) bind(element);
   for (auto& element : m_springs) bind(element);
   for (Index row = 0; row + 1 < Index(m_bendingRowOffsets.size()); ++row) {
     for (Index k = m_bendingRowOffsets[row]; k < m_bendingRowOffsets[row + 1]; ++k) {
-      m_bendingEntries[k].slot = matrix.slot(row, m_bendingEntries[k].column);
-      assert(m_bendingEntries[k].slot != kInvalidIndex && "matrix built without coupledPairs()");
+      m_bendingEntries[k].slot = slotOf(row, m_bendingEntries[k].column);
     }
   }
   m_diagonalSlots.resize(m_masses.size());
-  for (Index i = 0; i < m_masses.size(); ++i) m_diagonalSlots[i] = matrix.diagonalSlot(i);
+  for (Index i = 0; i < m_masses.size(); ++i) {
+    m_diagonalSlots[i] = map.row(i) == kInvalidIndex ? kInvalidIndex : matrix.diagonalSlot(map.row(i));
+  }
 }
 
 namespace {
@@ -241,12 +272,13 @@ void scatter(const ElementType& element, const ElementForces<N>& local, const Pa
     Vec3 product = Vec3::Zero();
     for (int b = 0; b < N; ++b) {
       const Mat3 positionBlock = local.positionJacobian.template block<3, 3>(3 * a, 3 * b);
-      if (pass.damping) {
-        pass.matrix->block(element.slots[a * N + b]) -=
-            pass.h * local.velocityJacobian.template block<3, 3>(3 * a, 3 * b) +
-            (pass.h * pass.h) * positionBlock;
-      } else {
-        pass.matrix->block(element.slots[a * N + b]) -= (pass.h * pass.h) * positionBlock;
+      if (Mat3* block = pass.blockAt(element.slots[a * N + b])) {
+        if (pass.damping) {
+          *block -= pass.h * local.velocityJacobian.template block<3, 3>(3 * a, 3 * b) +
+                    (pass.h * pass.h) * positionBlock;
+        } else {
+          *block -= (pass.h * pass.h) * positionBlock;
+        }
       }
       product += positionBlock * (*pass.velocityForProduct)[element.vertices[b]];
     }
@@ -284,8 +316,9 @@ Real ClothForces::evaluate(const Pass& pass) const {
             blockEnergy -= m_externalForces[i].dot(x[i]);
           }
           if (jacobians) {
-            pass.matrix->block(m_diagonalSlots[i]) =
-                (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();
+            if (Mat3* block = pass.blockAt(m_diagonalSlots[i])) {
+              *block = (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();
+            }
             (*pass.stiffnessTimesVelocity)[i].setZero();
           }
         }
@@ -390,7 +423,9 @@ Real ClothForces::evaluate(const Pass& pass) const {
         Vec3 product = Vec3::Zero();
         for (Index k = m_bendingRowOffsets[i]; k < m_bendingRowOffsets[i + 1]; ++k) {
           const BendingEntry& entry = m_bendingEntries[k];
-          pass.matrix->block(entry.slot).diagonal().array() += matrixScale * entry.value;
+          if (Mat3* block = pass.blockAt(entry.slot)) {
+            block->diagonal().array() += matrixScale * entry.value;
+          }
           product += entry.value * (*pass.velocityForProduct)[entry.column];
         }
         (*pass.stiffnessTimesVelocity)[i] -= stiffness * product;
@@ -424,13 +459,14 @@ Real ClothForces::computeForces(const Vec3Array& x, const Vec3Array& v, Vec3Arra
 
 Real ClothForces::assemble(const Vec3Array& x, const Vec3Array& v, Real h, BlockSparseMatrix& matrix,
                            Vec3Array& f, const Vec3Array& velocityForProduct,
-                           Vec3Array& stiffnessTimesVelocity) const {
+                           Vec3Array& stiffnessTimesVelocity, PinnedCoupling* coupling) const {
   f.resize(m_masses.size());
   stiffnessTimesVelocity.resize(m_masses.size());
   // Off-diagonal blocks accumulate; diagonal blocks are overwritten with M + h·drag first.
   matrix.setZero();
-  return evaluate(
-      Pass{x, v, f, h, &matrix, &velocityForProduct, &stiffnessTimesVelocity, m_damping});
+  if (coupling) coupling->setZero();
+  return evaluate(Pass{x, v, f, h, &matrix, &velocityForProduct, &stiffnessTimesVelocity,
+                       m_damping, coupling, m_couplingBase});
 }
 
 }  // namespace weft

@@ -25,6 +25,8 @@
 
 #include "forces/Condition.h"
 #include "solver/BlockSparseMatrix.h"
+#include "solver/FreeVertexMap.h"
+#include "solver/PinnedCoupling.h"
 
 #include <weft/threading/TaskSystem.h>
 
@@ -62,15 +64,22 @@ class ClothForces {
 
   /// Vertex pairs that some element couples: the sparsity pattern of the system matrix.
   std::vector<std::array<Index, 2>> coupledPairs() const;
-  /// Looks up, once, the matrix slot of every block every element writes.
+  /// Looks up, once, the matrix slot of every block every element writes (row i = vertex i).
   void bindMatrix(const BlockSparseMatrix& matrix);
+  /// The same with vertices removed from the system (FreeVertexMap.h): `matrix` has
+  /// map.rowCount() rows, blocks between a free row and a removed vertex go to `coupling`, and
+  /// the rows of removed vertices are not assembled at all. Call again when the map changes.
+  void bindMatrix(const BlockSparseMatrix& matrix, const FreeVertexMap& map,
+                  const PinnedCoupling& coupling);
 
   /// f(x, v) in N on every vertex; returns the potential energy in J (elastic + gravity).
   Real computeForces(const Vec3Array& x, const Vec3Array& v, Vec3Array& f) const;
   /// A = M − h ∂f/∂v − h² ∂f/∂x, f(x, v) and (∂f/∂x)·velocityForProduct; returns the energy.
+  /// f and the product cover every vertex; the matrix (and `coupling`, when bindMatrix() was
+  /// given one) the rows it was bound with.
   Real assemble(const Vec3Array& x, const Vec3Array& v, Real h, BlockSparseMatrix& matrix,
                 Vec3Array& f, const Vec3Array& velocityForProduct,
-                Vec3Array& stiffnessTimesVelocity) const;
+                Vec3Array& stiffnessTimesVelocity, PinnedCoupling* coupling = nullptr) const;
 
   const std::vector<Real>& masses() const { return m_masses; }
   /// Colours of each element kind (triangles, hinges, springs): fork/joins per assembly.
@@ -120,6 +129,9 @@ class ClothForces {
   // Elements are stored sorted by colour; colour k holds [colours[k], colours[k + 1]).
   std::vector<Index> m_triangleColours, m_hingeColours, m_springColours;
   std::vector<Index> m_diagonalSlots;
+  // Slots below this are matrix slots; from it on, PinnedCoupling slots offset by it;
+  // kInvalidIndex is a block of a removed vertex's row, which is not assembled.
+  Index m_couplingBase = kInvalidIndex;
   Vec3Array m_externalForces;  // N per vertex, or empty
   // Isometric bending: K̂ by rows (column, value, matrix slot), the stencils that hold each vertex
   // (for the force gather), and per-stencil scratch c_s (D r_s + k_d S_s v).

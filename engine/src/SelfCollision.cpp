@@ -29,6 +29,7 @@ void buildEdgeTables(const ClothModel& model, std::vector<std::array<Index, 2>>&
 SelfCollision::SelfCollision(const ClothModel& model, TaskSystem* tasks) : ContactResolver(tasks) {
   if (m_tasks) m_workerPairs = std::make_unique<PerWorker<std::vector<TrianglePair>>>(*m_tasks);
   m_bvh = Bvh::build(model.indices(), model.restPositions()).value();
+  m_sweptBvh = m_bvh;
   std::vector<std::array<Index, 3>> triangles(model.triangleCount());
   for (Index t = 0; t < model.triangleCount(); ++t) triangles[t] = m_bvh.triangle(t);
   std::vector<std::array<Index, 2>> edges;
@@ -39,11 +40,14 @@ SelfCollision::SelfCollision(const ClothModel& model, TaskSystem* tasks) : Conta
 }
 
 void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate,
-                                      bool, std::vector<TrianglePair>& pairs) {
+                                      bool proximity, std::vector<TrianglePair>& pairs) {
   WEFT_PROFILE_ZONE("broad phase");
-  m_bvh.refit(from, to, inflate, m_tasks);
+  Bvh& bvh = proximity ? m_bvh : m_sweptBvh;
+  bvh.refit(from, to, inflate, m_tasks);
+  m_refitCounts.refitNodes += bvh.lastRefitCounts().refitNodes;
+  m_refitCounts.skippedNodes += bvh.lastRefitCounts().skippedNodes;
   if (m_tasks && m_workerPairs) {
-    m_bvh.querySelf(pairs, *m_tasks, *m_workerPairs);
+    bvh.querySelf(pairs, *m_tasks, *m_workerPairs);
     // Which worker finds which pairs depends on scheduling, so a worker's list may need any
     // share of the total: give each room for all of it, so that allocation follows the number
     // of pairs (which grows only with contact) and never the timing of the threads.
@@ -52,8 +56,13 @@ void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to
       if (list.capacity() < total) list.reserve(total);
     });
   } else {
-    m_bvh.querySelf(pairs);
+    bvh.querySelf(pairs);
   }
+}
+
+void SelfCollision::setRefitSkipping(Real motion) {
+  m_bvh.setRefitMargin(motion);
+  m_sweptBvh.setRefitMargin(motion);
 }
 
 SelfCollisionReport SelfCollision::resolve(const Vec3Array& start, Real h, Real thickness,

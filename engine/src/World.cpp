@@ -447,6 +447,8 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.selfCollisionSkipped += report.stages.selfCollisionSkipped;
     stats.bendingAssemblies += report.stages.bendingAssemblies;
     stats.dampingJacobians += report.stages.dampingJacobians;
+    stats.bvhNodesRefit += report.stages.bvhNodesRefit;
+    stats.bvhNodesSkipped += report.stages.bvhNodesSkipped;
     stats.frozenVertices += report.selfCollision.frozenVertices;
     totalSubsteps += report.substeps;
     stats.contacts += report.contacts;
@@ -462,6 +464,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.potentialEnergy += report.integrator.potentialEnergy;
     stats.assemblyMs += report.integrator.assemblyMs;
     stats.solveMs += report.integrator.solveMs;
+    stats.solvedUnknowns += report.integrator.solvedUnknowns;
     stats.kineticEnergy += report.kineticEnergy;
     stats.maxStrain = std::max(stats.maxStrain, report.maxStrain);
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());

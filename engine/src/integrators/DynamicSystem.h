@@ -8,6 +8,7 @@
 #pragma once
 
 #include "solver/BlockSparseMatrix.h"
+#include "solver/FreeVertexMap.h"
 #include "solver/VertexFilter.h"
 
 #include <weft/Math.h>
@@ -36,8 +37,19 @@ class DynamicSystem {
   /// Returns the potential energy in J, as computeForces() does.
   virtual Real linearize(const Vec3Array& x, const Vec3Array& v, Real t, Real h, Vec3Array& f,
                          const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) = 0;
-  /// The matrix linearize() assembles into; its pattern never changes.
+  /// The matrix linearize() assembles into; its pattern never changes. Its rows are the
+  /// vertices of freeVertexMap() (all vertices when that is null).
   virtual const BlockSparseMatrix& systemMatrix() const = 0;
+
+  /// Rows of systemMatrix(): null when row i is vertex i. Prescribed vertices without a row are
+  /// removed from the solve; their known velocity change enters through
+  /// subtractPrescribedCoupling(). Prescribed vertices with a row are filtered (S = 0).
+  virtual const FreeVertexMap* freeVertexMap() const { return nullptr; }
+  /// rows[r] −= Σ_p A(r, p) deltaV[p] over the removed prescribed vertices p, with the blocks of
+  /// the last linearize(); deltaV is indexed by vertex, rows by row. Default: nothing is removed.
+  virtual void subtractPrescribedCoupling(const Vec3Array& deltaV, Vec3Array& rows) const {
+    (void)deltaV, (void)rows;
+  }
 
   /// Vertices whose motion is prescribed (pinned), in increasing order.
   virtual std::span<const Index> prescribedVertices() const = 0;
@@ -46,7 +58,8 @@ class DynamicSystem {
   virtual void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const = 0;
 
   /// Adds contact constraints to the implicit solve's filter for a step of length h from (x, v)
-  /// (Baraff & Witkin §5.3), releasing the previous step's first. Default: no contacts.
+  /// (Baraff & Witkin §5.3), releasing the previous step's first. The filter is indexed by row
+  /// of systemMatrix() (see freeVertexMap()). Default: no contacts.
   virtual void constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                                  VertexFilter& filter) {
     (void)x, (void)v, (void)h, (void)filter;

@@ -20,22 +20,28 @@ void ImplicitEuler::restoreCarriedState(const Vec3Array& in) {
     reset();
     return;
   }
-  resize(Index(in.size()));
+  resizeVertices(Index(in.size()));
   m_deltaV = in;
   m_hasWarmStart = true;
 }
 
-void ImplicitEuler::resize(Index vertexCount) {
+void ImplicitEuler::resizeVertices(Index vertexCount) {
   if (m_deltaV.size() == vertexCount) return;
-  m_pcg.resize(vertexCount);
-  m_filter.resize(vertexCount);
-  m_filteredVertices.clear();
-  for (Vec3Array* array : {&m_deltaV, &m_correction, &m_force, &m_stiffnessTimesVelocity,
-                           &m_rightHandSide, &m_iteratePosition, &m_iterateVelocity,
-                           &m_prescribedPosition, &m_prescribedVelocity}) {
+  for (Vec3Array* array : {&m_deltaV, &m_force, &m_stiffnessTimesVelocity, &m_rightHandSide,
+                           &m_iteratePosition, &m_iterateVelocity, &m_prescribedPosition,
+                           &m_prescribedVelocity}) {
     array->assign(vertexCount, Vec3::Zero());
   }
   m_hasWarmStart = false;
+}
+
+void ImplicitEuler::resizeRows(Index rowCount) {
+  if (m_correction.size() == rowCount && m_filter.size() == rowCount) return;
+  m_pcg.resize(rowCount);
+  m_filter.resize(rowCount);
+  m_filteredRows.clear();
+  m_correction.assign(rowCount, Vec3::Zero());
+  m_rowRightHandSide.assign(rowCount, Vec3::Zero());
 }
 
 void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
@@ -45,28 +51,45 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   pcgSettings.warmStart = true;  // the caller prepares the initial guess in m_correction
   WEFT_PROFILE_ZONE("solve");
   const std::int64_t start = FrameClock::nowNs();
-  const SolveReport solve = m_pcg.solve(system.systemMatrix(), m_rightHandSide, m_filter,
+  const SolveReport solve = m_pcg.solve(system.systemMatrix(), m_rowRightHandSide, m_filter,
                                         pcgSettings, m_correction, system.taskSystem());
   report.solveMs += FrameClock::msSince(start);
   ++report.linearSolves;
   report.cgIterations += solve.iterations;
   report.cgResidual = solve.relativeResidual;
   report.cgConverged = report.cgConverged && solve.converged;
+  report.solvedUnknowns = 3 * Index(m_correction.size());
 }
 
 void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
                          IntegratorReport& report) {
   const Index n = system.vertexCount();
-  resize(n);
+  resizeVertices(n);
+  const FreeVertexMap* systemMap = system.freeVertexMap();
+  if (!systemMap && m_identityMap.vertexCount() != n) m_identityMap.build(n, {});
+  const FreeVertexMap& map = systemMap ? *systemMap : m_identityMap;
+  const Index rows = map.rowCount();
+  resizeRows(rows);
   const std::vector<Real>& masses = system.masses();
 
-  // Pins: the velocity change that puts each pinned vertex exactly on its target at t + h.
-  for (Index vertex : m_filteredVertices) m_filter.setFree(vertex);
-  m_filteredVertices.assign(system.prescribedVertices().begin(), system.prescribedVertices().end());
+  // Pins: the velocity change that puts each pinned vertex exactly on its target at t + h. A pin
+  // with a row is fixed in the filter; a removed one keeps its Δv in m_deltaV, where the
+  // coupling product below and the update at the end read it.
+  for (Index row : m_filteredRows) m_filter.setFree(row);
+  m_filteredRows.clear();  // keeps its capacity: no allocation after the first step
   // applyPrescribedMotion writes every prescribed entry, and only those are read below.
   system.applyPrescribedMotion(t + h, m_prescribedPosition, m_prescribedVelocity);
-  for (Index vertex : m_filteredVertices) {
-    m_filter.setFixed(vertex, (m_prescribedPosition[vertex] - x[vertex]) / h - v[vertex]);
+  bool removedPins = false;
+  for (Index vertex : system.prescribedVertices()) {
+    const Vec3 target = (m_prescribedPosition[vertex] - x[vertex]) / h - v[vertex];
+    const Index row = map.row(vertex);
+    if (row == kInvalidIndex) {
+      m_deltaV[vertex] = target;
+      removedPins = true;
+    } else {
+      m_filter.setFixed(row, target);
+      m_filteredRows.push_back(row);
+    }
   }
   // Contacts with colliders: one constrained direction each.
   system.constrainContacts(x, v, h, m_filter);
@@ -81,20 +104,26 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   for (Index i = 0; i < n; ++i) {
     m_rightHandSide[i] = h * (m_force[i] + h * m_stiffnessTimesVelocity[i]);
   }
-  // Initial guess: last step's Δv (warm start) or zero; the filter puts pinned entries on target.
-  for (Index i = 0; i < n; ++i) {
-    m_correction[i] = (m_settings.warmStart && m_hasWarmStart) ? m_deltaV[i] : Vec3::Zero();
+  map.gather(m_rightHandSide, m_rowRightHandSide);
+  // b_f − A_fp Δv_p: the pull of removed pins on their free neighbours.
+  if (removedPins) system.subtractPrescribedCoupling(m_deltaV, m_rowRightHandSide);
+  // Initial guess: last step's Δv (warm start) or zero; the filter puts fixed entries on target.
+  if (m_settings.warmStart && m_hasWarmStart) {
+    map.gather(m_deltaV, m_correction);
+  } else {
+    for (Index row = 0; row < rows; ++row) m_correction[row].setZero();
   }
   solve(system, report);
-  m_deltaV = m_correction;
+  map.scatter(m_correction, m_deltaV);
 
-  // Newton iterations on M Δv = h f(x_n + h(v_n + Δv), v_n + Δv); pinned vertices stay on target.
+  // Newton iterations on M Δv = h f(x_n + h(v_n + Δv), v_n + Δv); pinned vertices stay on target
+  // (their correction is zero, so removed pins add nothing to the right-hand side).
   if (m_settings.newtonIterations > 0) {
-    for (Index vertex : m_filteredVertices) m_filter.setFixed(vertex, Vec3::Zero());
+    for (Index row : m_filteredRows) m_filter.setFixed(row, Vec3::Zero());
     // Contact constraints are met by Δv already: corrections stay tangent to the contacts.
-    for (Index vertex = 0; vertex < n; ++vertex) {
-      if (m_filter.kind(vertex) == ConstraintKind::OneDirection) {
-        m_filter.setConstrained(vertex, m_filter.direction(vertex, 0), Vec3::Zero());
+    for (Index row = 0; row < rows; ++row) {
+      if (m_filter.kind(row) == ConstraintKind::OneDirection) {
+        m_filter.setConstrained(row, m_filter.direction(row, 0), Vec3::Zero());
       }
     }
   }
@@ -110,12 +139,11 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
                        m_stiffnessTimesVelocity);
       report.assemblyMs += FrameClock::msSince(start);
     }
-    for (Index i = 0; i < n; ++i) {
-      m_rightHandSide[i] = h * m_force[i] - masses[i] * m_deltaV[i];
-      m_correction[i].setZero();
-    }
+    for (Index i = 0; i < n; ++i) m_rightHandSide[i] = h * m_force[i] - masses[i] * m_deltaV[i];
+    map.gather(m_rightHandSide, m_rowRightHandSide);
+    for (Index row = 0; row < rows; ++row) m_correction[row].setZero();
     solve(system, report);
-    for (Index i = 0; i < n; ++i) m_deltaV[i] += m_correction[i];
+    for (Index row = 0; row < rows; ++row) m_deltaV[map.vertex(row)] += m_correction[row];
   }
 
   for (Index i = 0; i < n; ++i) {

@@ -9,9 +9,14 @@
 //      (M − h ∂f/∂v − h² ∂f/∂x)|_k δ = h f(x_k, v_k) − M Δv_k,      Δv_{k+1} = Δv_k + δ
 //  which converges to the exact backward-Euler step M Δv = h f(x_{n+1}, v_{n+1}).
 //
-// Pins enter through the filter (BW98 §5.3): a pinned vertex gets S = 0 and the target
-// Δv = (x_target(t + h) − x_n)/h − v_n, so it lands exactly on its target whatever drift came
-// before. Warm start: the PCG begins from the previous step's Δv, which is close in smooth motion.
+// Pins: a pinned vertex's velocity change is known, Δv_p = (x_target(t + h) − x_n)/h − v_n, so it
+// lands exactly on its target whatever drift came before (for a pin moving at constant velocity
+// within a frame Δv_p is zero after the frame's first substep; it is the pin's change of velocity
+// otherwise). When the system removes pinned vertices (DynamicSystem::freeVertexMap()) the solve
+// runs over the free rows only, A_ff Δv_f = b_f − A_fp Δv_p; pinned vertices that keep a row are
+// filtered instead (BW98 §5.3: S = 0, target Δv_p), which solves the same equations. Contacts are
+// always filtered. Warm start: the PCG begins from the previous step's Δv, which is close in smooth
+// motion.
 #pragma once
 
 #include "integrators/Integrator.h"
@@ -39,18 +44,21 @@ class ImplicitEuler final : public Integrator {
   void restoreCarriedState(const Vec3Array& in) override;
 
  private:
-  void resize(Index vertexCount);
+  void resizeVertices(Index vertexCount);
+  void resizeRows(Index rowCount);
   void solve(DynamicSystem& system, IntegratorReport& report);
 
   SolverSettings m_settings;
   FilteredPcg m_pcg;
-  VertexFilter m_filter;
-  std::vector<Index> m_filteredVertices;  // vertices set fixed in m_filter last step
-  Vec3Array m_deltaV;            // Δv of this step; the previous one is the warm start
-  Vec3Array m_correction;        // δ of a Newton iteration
+  VertexFilter m_filter;                  // by system row
+  std::vector<Index> m_filteredRows;      // rows of pins set fixed in m_filter last step
+  FreeVertexMap m_identityMap;            // for systems that remove nothing (freeVertexMap() null)
+  Vec3Array m_deltaV;            // Δv of this step by vertex; the previous one is the warm start
+  Vec3Array m_correction;        // by row: the solve's unknown (Δv, or δ of a Newton iteration)
+  Vec3Array m_rowRightHandSide;  // by row: b gathered, minus the removed pins' coupling
   Vec3Array m_force;             // f at the expansion point
   Vec3Array m_stiffnessTimesVelocity;
-  Vec3Array m_rightHandSide;     // b
+  Vec3Array m_rightHandSide;     // b by vertex
   Vec3Array m_iteratePosition;   // x_k
   Vec3Array m_iterateVelocity;   // v_k
   Vec3Array m_prescribedPosition, m_prescribedVelocity;

@@ -24,6 +24,9 @@ struct IntegratorReport {
   Real potentialEnergy = 0;   ///< J, at the start of the step (as evaluated by the method)
   Real assemblyMs = 0;        ///< ms spent evaluating forces and assembling the system
   Real solveMs = 0;           ///< ms spent in PCG solves
+  /// Scalar unknowns of the last linear solve: 3 per row of the system (free vertices when
+  /// pinned vertices are removed from the solve); 0 without a solve.
+  Index solvedUnknowns = 0;
 };
 
 class Integrator {

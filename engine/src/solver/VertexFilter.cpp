@@ -36,6 +36,12 @@ void VertexFilter::setFixed(Index vertex, const Vec3& target) {
   m_targets[vertex] = target;
 }
 
+void VertexFilter::copyConstraint(Index vertex, const VertexFilter& from, Index fromVertex) {
+  setKind(vertex, from.kind(fromVertex));
+  m_targets[vertex] = from.m_targets[fromVertex];
+  m_directions[vertex] = from.m_directions[fromVertex];
+}
+
 void VertexFilter::setConstrained(Index vertex, const Vec3& direction, const Vec3& target) {
   const Real length = direction.norm();
   assert(length > 0 && std::isfinite(length) &&

@@ -69,6 +69,10 @@ class VertexFilter {
   void setConstrained(Index vertex, const Vec3& direction0, const Vec3& direction1,
                       const Vec3& target);
 
+  /// Gives `vertex` exactly the constraint (kind, directions, target) that `from` holds for
+  /// `fromVertex`, bit for bit: renumbers constraints gathered by vertex into system rows.
+  void copyConstraint(Index vertex, const VertexFilter& from, Index fromVertex);
+
   /// The vertex's kind of constraint.
   ConstraintKind kind(Index vertex) const { return static_cast<ConstraintKind>(m_kinds[vertex]); }
 

@@ -40,6 +40,20 @@
 // Thickness. Every triangle box is inflated by `thickness` on every side, so every pair of
 // triangles whose swept volumes come within 2 · thickness of each other is a candidate.
 //
+// Skipping the refit of what did not move (setRefitMargin). A cloth resting on the floor, or the
+// part of it that does, moves by round-off from step to step, yet a full refit rewrites every
+// box. With a margin m ≥ 0 the tree keeps two kinds of box: every triangle's own box is still
+// recomputed exactly every refit (that pass is needed to know what moved, and it keeps queries
+// exact, see below), but a leaf's box is inflated by m when it is refit and kept as long as it
+// still contains its triangles' boxes and is no more than 2m larger than them on any side, i.e.
+// until its triangles have moved more than m. An internal node is recomputed only when one of
+// its children's boxes changed, so a still part of the tree costs one containment test per leaf
+// and nothing above it. Queries stay exact: node boxes are only used to prune, and every query
+// tests the exact triangle boxes at the leaves, so the pairs it returns (sorted) are bit for bit
+// those of a tree refit every step; only the amount of pruning changes (leaves up to 2m larger).
+// Deterministic: a node reads its children's flags and writes only its own, level by level.
+// A negative margin (the default) refits every node every time.
+//
 // Ordering and threads. Every query sorts its output (a linear-time radix sort, PairSort.h), so
 // results do not depend on traversal order. Queries are const and keep no state in the tree:
 // several threads may query one tree at once; refit must not run concurrently with a query.
@@ -65,6 +79,7 @@
 
 #include <array>
 #include <compare>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -119,6 +134,20 @@ class Bvh {
   /// With `tasks`, the loops run through its parallelFor (same bits as serial).
   void refit(std::span<const Vec3> oldPositions, std::span<const Vec3> newPositions,
              Real thickness, TaskSystem* tasks = nullptr);
+
+  /// m: how far a leaf's triangles may move before its box is refit (see the design note):
+  /// negative (the default) refits every node on every refit; 0 skips only nodes whose boxes
+  /// come out bit for bit unchanged; m > 0 inflates leaf boxes by m and skips leaves whose
+  /// triangles moved less than m, and every internal node above only skipped children. Raising it
+  /// skips more refits and prunes the queries less (their results never change).
+  void setRefitMargin(Real margin) { m_refitMargin = margin; }
+  Real refitMargin() const { return m_refitMargin; }
+  /// Nodes the last refit recomputed and nodes it kept (sum: nodes().size()).
+  struct RefitCounts {
+    Index refitNodes = 0;    ///< nodes whose box was recomputed
+    Index skippedNodes = 0;  ///< nodes whose box was kept
+  };
+  const RefitCounts& lastRefitCounts() const { return m_lastRefit; }
 
   /// Clears `pairs`, then writes every pair (i < j) of triangles whose boxes overlap and that
   /// share no vertex, sorted.
@@ -178,6 +207,10 @@ class Bvh {
   std::vector<Node> m_nodes;                      // level order
   std::vector<Index> m_levelBegins;               // first node of each level, then m_nodes.size()
   std::vector<NodePair> m_selfTasks;              // first == second: self(first); else a pair
+  // Per node, last refit: bit 0 = recomputed, bit 1 = box changed (read by the parent).
+  std::vector<std::uint8_t> m_nodeRefitFlags;
+  Real m_refitMargin = -1;                        // negative: refit everything (setRefitMargin)
+  RefitCounts m_lastRefit;
   Index m_vertexCount = 0;
 };
 

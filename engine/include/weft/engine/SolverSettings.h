@@ -37,6 +37,10 @@ struct SolverSettings {
   Real cgTolerance = 1e-3;
   int cgMaxIterations = 200;  ///< PCG iteration cap per solve
   bool warmStart = true;      ///< start each PCG from the previous step's Δv
+  /// Take pinned vertices out of the implicit system (their known velocity change moves to the
+  /// right-hand side) instead of keeping them in it filtered (S = 0). Same equations, so the same
+  /// motion up to the solve tolerance; the solve shrinks by one row per pin. false is for checks.
+  bool removePinnedVertices = true;
 };
 
 }  // namespace weft

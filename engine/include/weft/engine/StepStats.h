@@ -109,6 +109,15 @@ struct StepStats {
   /// The check the last failed attempt at this frame tripped (None when no attempt failed): why
   /// the frame was retried or rolled back. With several cloths, the first cloth that failed.
   HealthFailure healthFailure = HealthFailure::None;
+  /// Scalar unknowns of the implicit solve, summed over cloths (each cloth's last solve of the
+  /// frame): 3 per free vertex, since pinned vertices are removed from the system
+  /// (SolverSettings::removePinnedVertices); 3 per vertex when they are kept. 0 without a solve.
+  Index solvedUnknowns = 0;
+  /// Self-collision BVH nodes whose boxes were recomputed (all refits of all substeps), and
+  /// nodes kept because their triangles moved less than a margin since their last refit
+  /// (WorldSettings::skipUnneededStages; the collision results are the same bits either way).
+  Index bvhNodesRefit = 0;
+  Index bvhNodesSkipped = 0;
 };
 
 }  // namespace weft
