@@ -275,10 +275,11 @@ void ContactResolver::clampToColliders(const Vec3Array& start, Real h) {
     if (!m_touched[i]) continue;
     const Real thickness = m_owners[m_owner[i]].thickness;
     for (const ColliderFrame& collider : m_colliders) {
-      const ShapeContact contact = queryPoint(*collider.shape, start[i] + h * m_velocity[i]);
-      if (contact.distance < thickness) {
-        m_velocity[i] += ((thickness - contact.distance) / h) * contact.normal;
-      }
+      // Not only where the corrected step ends but the way there, relative to the body: an
+      // impulse may send a vertex through a thin or fast body without ending inside it.
+      const Vec3 end = start[i] + h * m_velocity[i];
+      const Vec3 outside = keepOutside(collider, start[i], end, thickness);
+      if (outside != end) m_velocity[i] = (outside - start[i]) / h;
     }
   }
 }
