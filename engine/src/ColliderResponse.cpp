@@ -76,10 +76,15 @@ std::optional<PathContact> firstContact(const Shape& shape, const Vec3& a, const
   const Real length = travel.norm();
   if (length == 0) return std::nullopt;
   // Sphere tracing: the shapes return exact Euclidean distances, so stepping by the distance
-  // minus half the level never steps over the level set. Each step covers at least half the
-  // level; a path that would need more steps grazes the shell, and is stopped where the budget
-  // ends (early rather than through: the caller slides it on from there).
+  // minus half the level never steps over the level set. A path that starts in the shell steps
+  // at least a quarter of the thickness at a time: tracing it by its distance alone would crawl
+  // along a surface it lies on (a tiny level, a tiny step), and then run out of steps and stop a
+  // sliding vertex. That minimum can cut a dip below the level shorter than a quarter thickness,
+  // never a crossing of a body thicker than that: a sample beyond the surface is found. A path
+  // still not through after the step budget is stopped where it got (early rather than
+  // through: the caller slides it on from there).
   constexpr int kMaxSteps = 256;
+  const Real minimumStep = 0.25 * thickness;
   Real s = 0;
   for (int step = 0; step < kMaxSteps; ++step) {
     const Vec3 point = a + s * travel;
@@ -87,8 +92,13 @@ std::optional<PathContact> firstContact(const Shape& shape, const Vec3& a, const
     if (contact.distance < level || step + 1 == kMaxSteps) {
       return PathContact{s, point, contact.normal, contact.distance};
     }
-    s += (contact.distance - 0.5 * level) / length;
-    if (s > 1) return std::nullopt;
+    s += std::max(contact.distance - 0.5 * level, minimumStep) / length;
+    if (s > 1) {
+      // The end itself, which the last step may have passed over.
+      const ShapeContact end = queryPoint(shape, b);
+      if (end.distance < level) return PathContact{1, b, end.normal, end.distance};
+      return std::nullopt;
+    }
   }
   return std::nullopt;
 }
