@@ -430,14 +430,17 @@ void Cloth::selectNearColliders(std::span<const ColliderFrame> colliders, const 
 
 void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                               VertexFilter& filter) {
-  // The constraint pass tests the predicted positions x + h v of free vertices.
-  Aabb predicted = Aabb::empty();
+  // The constraint pass tests the paths from the start points x (carried with each body) to
+  // the predicted positions x + h v of free vertices.
+  Aabb predicted = Aabb::empty(), start = Aabb::empty();
   if (m_skipStages && !m_colliders.empty()) {
     for (Index i = 0; i < vertexCount(); ++i) {
-      if (!m_pinnedMask[i]) predicted.expand(Vec3(x[i] + h * v[i]));
+      if (m_pinnedMask[i]) continue;
+      predicted.expand(Vec3(x[i] + h * v[i]));
+      start.expand(x[i]);
     }
   }
-  selectNearColliders(m_colliders, predicted, nullptr);
+  selectNearColliders(m_colliders, predicted, &start);
   if (m_freeVertexMap.isIdentity()) {
     m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
                                  m_pinnedMask, filter);

@@ -32,10 +32,24 @@ Index ColliderResponse::constrain(std::span<const ColliderFrame> colliders, cons
     Real deepest = thickness;
     Vec3 normal = Vec3::Zero();
     for (const ColliderFrame& collider : colliders) {
-      const ShapeContact contact = queryPoint(*collider.shape, predicted);
-      if (contact.distance < deepest) {
-        deepest = contact.distance;
-        normal = contact.normal;
+      // The predicted motion relative to the body, from the start point carried with it: where
+      // it first meets the body gives the face to stop on. The end pose alone would push a
+      // vertex that a fast body overran out through the nearest face, the side or the far one.
+      const Vec3 carriedStart = collider.end.pose.toWorld(collider.start.pose.toLocal(x[i]));
+      Real depth;  // signed distance of the predicted point along the chosen normal
+      Vec3 direction;
+      if (const std::optional<PathContact> hit =
+              firstContact(*collider.shape, carriedStart, predicted, thickness)) {
+        direction = hit->normal;
+        depth = hit->distance + hit->normal.dot(predicted - hit->point);
+      } else {
+        const ShapeContact contact = queryPoint(*collider.shape, predicted);
+        direction = contact.normal;
+        depth = contact.distance;
+      }
+      if (depth < deepest) {
+        deepest = depth;
+        normal = direction;
       }
     }
     if (normal.isZero()) continue;
@@ -51,28 +65,76 @@ void ColliderResponse::release(VertexFilter& filter) {
   m_constrained.clear();
 }
 
-namespace {
-
-// Earliest parameter s ∈ [0, 1] at which the segment a → b comes within `thickness` of the
-// shape, by sphere tracing: the shapes return exact Euclidean distances, so stepping by the
-// distance minus the thickness never steps over the surface. −1 when the segment stays clear.
-Real sweptContact(const Shape& shape, const Vec3& a, const Vec3& b, Real thickness) {
+std::optional<PathContact> firstContact(const Shape& shape, const Vec3& a, const Vec3& b,
+                                        Real thickness) {
+  const Real startDistance = queryPoint(shape, a).distance;
+  if (!(startDistance > 0)) return std::nullopt;  // starts inside: only a projection can help
+  // A path that starts within the thickness (a vertex in resting contact) is stopped where it
+  // gets halfway from there to the surface: it may move about in the shell, never through it.
+  const Real level = startDistance >= thickness ? thickness : 0.5 * startDistance;
   const Vec3 travel = b - a;
   const Real length = travel.norm();
+  if (length == 0) return std::nullopt;
+  // Sphere tracing: the shapes return exact Euclidean distances, so stepping by the distance
+  // minus half the level never steps over the level set. A path that starts in the shell steps
+  // at least a quarter of the thickness at a time: tracing it by its distance alone would crawl
+  // along a surface it lies on (a tiny level, a tiny step), and then run out of steps and stop a
+  // sliding vertex. That minimum can cut a dip below the level shorter than a quarter thickness,
+  // never a crossing of a body thicker than that: a sample beyond the surface is found. A path
+  // still not through after the step budget is stopped where it got (early rather than
+  // through: the caller slides it on from there).
+  constexpr int kMaxSteps = 256;
+  const Real minimumStep = 0.25 * thickness;
   Real s = 0;
-  // 64 steps: each one halves the remaining distance or better near a surface; a segment that
-  // needs more is grazing, and the projection at the end handles a graze.
-  for (int step = 0; step < 64; ++step) {
-    const Real distance = queryPoint(shape, a + s * travel).distance;
-    if (distance < thickness) return s;
-    if (length == 0) return -1;
-    s += (distance - 0.5 * thickness) / length;
-    if (s > 1) return -1;
+  for (int step = 0; step < kMaxSteps; ++step) {
+    const Vec3 point = a + s * travel;
+    const ShapeContact contact = queryPoint(shape, point);
+    if (contact.distance < level || step + 1 == kMaxSteps) {
+      return PathContact{s, point, contact.normal, contact.distance};
+    }
+    s += std::max(contact.distance - 0.5 * level, minimumStep) / length;
+    if (s > 1) {
+      // The end itself, which the last step may have passed over.
+      const ShapeContact end = queryPoint(shape, b);
+      if (end.distance < level) return PathContact{1, b, end.normal, end.distance};
+      return std::nullopt;
+    }
   }
-  return -1;
+  return std::nullopt;
 }
 
-}  // namespace
+Vec3 keepOutside(const ColliderFrame& collider, const Vec3& start, const Vec3& end, Real thickness,
+                 bool* sweptHit) {
+  const Shape& shape = *collider.shape;
+  // Follow the motion relative to the body: the start point, carried with the body to the end
+  // pose.
+  const Vec3 carriedStart = collider.end.pose.toWorld(collider.start.pose.toLocal(start));
+  Vec3 x = end;
+  std::optional<PathContact> hit = firstContact(shape, carriedStart, x, thickness);
+  if (sweptHit) *sweptHit = hit.has_value();
+  // From a hit the vertex keeps its motion relative to the body except the part into the
+  // surface (inelastic): it slides on. Carrying it with the body instead would glue a vertex
+  // that merely brushed a collider to it, and a collider sliding past the cloth would drag it
+  // along. The slide is tested again (a concave body, or a curved one it slides into); after a
+  // few slides that still hit, it stays at the last hit point, which is outside.
+  constexpr int kSlides = 3;
+  for (int slide = 0; hit; ++slide) {
+    if (slide == kSlides) {
+      x = hit->point;
+      break;
+    }
+    Vec3 remaining = x - hit->point;
+    const Real inward = remaining.dot(hit->normal);
+    if (inward < 0) remaining -= inward * hit->normal;
+    x = hit->point + remaining;
+    hit = firstContact(shape, hit->point, x, thickness);
+  }
+  // Onto the surface plus thickness: the path there is clear, so the nearest face is the one it
+  // came to (a vertex that slid clear of the surface stays where it is).
+  const ShapeContact contact = queryPoint(shape, x);
+  if (contact.distance < thickness) x += (thickness - contact.distance) * contact.normal;
+  return x;
+}
 
 ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> colliders,
                                                  const Vec3Array& xStart, const Vec3Array& vStart,
@@ -88,31 +150,13 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
     bool touched = false;
     for (const ColliderFrame& collider : colliders) {
       const Shape& shape = *collider.shape;
-      ShapeContact contact = queryPoint(shape, x[i]);
-      if (contact.distance >= thickness) {
-        // Outside at the end: did the vertex pass through the collider on the way? Follow its
-        // motion relative to the body: its start point, carried with the body to the end pose.
-        const Vec3 carriedStart =
-            collider.end.pose.toWorld(collider.start.pose.toLocal(xStart[i]));
-        if (queryPoint(shape, carriedStart).distance < thickness) continue;  // started in contact: projection handles it
-        const Real s = sweptContact(shape, carriedStart, x[i], thickness);
-        if (s < 0) continue;
-        // The vertex met the surface at s. For the rest of the step it keeps its motion relative
-        // to the body except the part into the surface (inelastic): it slides on. Carrying it
-        // with the body instead would glue a vertex that merely brushed a collider to it, and a
-        // collider sliding past the cloth would drag it along.
-        const Vec3 relativeTravel = x[i] - carriedStart;
-        const Vec3 hit = carriedStart + s * relativeTravel;
-        const Vec3 hitNormal = queryPoint(shape, hit).normal;
-        Vec3 remaining = (1 - s) * relativeTravel;
-        const Real inward = remaining.dot(hitNormal);
-        if (inward < 0) remaining -= inward * hitNormal;
-        x[i] = hit + remaining;
-        contact = queryPoint(shape, x[i]);
-        ++report.sweptHits;
-      }
-      // Onto the surface plus thickness (a vertex that slid clear of it stays where it is).
-      if (contact.distance < thickness) x[i] += (thickness - contact.distance) * contact.normal;
+      const bool endClear = queryPoint(shape, x[i]).distance >= thickness;
+      bool sweptHit = false;
+      const Vec3 outside = keepOutside(collider, xStart[i], x[i], thickness, &sweptHit);
+      if (endClear && !sweptHit) continue;  // neither near at the end nor met on the way
+      if (endClear) ++report.sweptHits;
+      x[i] = outside;
+      const ShapeContact contact = queryPoint(shape, x[i]);
       // Inelastic: no relative velocity into the surface.
       const Vec3 relative = v[i] - contact.velocity;
       const Real normalSpeed = relative.dot(contact.normal);

@@ -26,6 +26,7 @@
 #include <weft/Math.h>
 #include <weft/collision/Shape.h>
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -41,6 +42,29 @@ struct ColliderFrame {
 
 /// Where a collider's motion puts it `dt` seconds later (constant linear and angular velocity).
 RigidMotion advanceMotion(const RigidMotion& motion, Real dt);
+
+/// Where a path first comes near a shape.
+struct PathContact {
+  Real s = 0;        ///< parameter along the path, 0 at its start, 1 at its end
+  Vec3 point;        ///< the point of the path there
+  Vec3 normal;       ///< the shape's outward normal there
+  Real distance = 0; ///< m, the point's signed distance to the shape
+};
+
+/// The first point of the segment a → b (relative to the shape, i.e. a already carried with a
+/// moving body) closer to the shape than `thickness`, or, for a path that starts within the
+/// thickness, closer than half its start distance (so a vertex in resting contact may move in
+/// the shell but not through the surface). None when the path stays clear or starts inside.
+std::optional<PathContact> firstContact(const Shape& shape, const Vec3& a, const Vec3& b,
+                                        Real thickness);
+
+/// Where a vertex moving from `start` to `end` over a step ends without passing through the
+/// collider (posed at the end of the step) or ending within its thickness: the path relative to
+/// the body is stopped where it first meets the surface and slides on from there without its
+/// inward part; what is still within the thickness goes onto it along the normal. `sweptHit`
+/// tells whether the path met the surface.
+Vec3 keepOutside(const ColliderFrame& collider, const Vec3& start, const Vec3& end, Real thickness,
+                 bool* sweptHit = nullptr);
 
 /// Statistics of one response pass.
 struct ColliderResponseReport {

@@ -275,10 +275,11 @@ void ContactResolver::clampToColliders(const Vec3Array& start, Real h) {
     if (!m_touched[i]) continue;
     const Real thickness = m_owners[m_owner[i]].thickness;
     for (const ColliderFrame& collider : m_colliders) {
-      const ShapeContact contact = queryPoint(*collider.shape, start[i] + h * m_velocity[i]);
-      if (contact.distance < thickness) {
-        m_velocity[i] += ((thickness - contact.distance) / h) * contact.normal;
-      }
+      // Not only where the corrected step ends but the way there, relative to the body: an
+      // impulse may send a vertex through a thin or fast body without ending inside it.
+      const Vec3 end = start[i] + h * m_velocity[i];
+      const Vec3 outside = keepOutside(collider, start[i], end, thickness);
+      if (outside != end) m_velocity[i] = (outside - start[i]) / h;
     }
   }
 }
@@ -294,6 +295,24 @@ void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpee
     effectiveInverseMass += contact.weights[k] * contact.weights[k] * inverseMass[k];
   }
   if (effectiveInverseMass <= 0) return;  // all four pinned: nothing can move
+  // Held vertices count as heavy so that the free side takes the impulse. But when the free side
+  // holds the pair point only with a small weight w (a vertex near the end of an edge, near a
+  // corner of a triangle), taking all of the relative change throws that vertex at Δu / w: a
+  // layer landing on another draped over a sphere got 10–20 m/s this way. When any vertex would
+  // change by more than the relative change, the true masses share the impulse instead (with
+  // equal masses no vertex then changes by more than Δu); the clamp afterwards puts back what
+  // reaches into a collider, and the next sweep gives the rest to the free side.
+  Real largestShare = 0;
+  for (int k = 0; k < 4; ++k) {
+    largestShare = std::max(largestShare, std::abs(contact.weights[k]) * inverseMass[k]);
+  }
+  if (largestShare > effectiveInverseMass) {
+    effectiveInverseMass = 0;
+    for (int k = 0; k < 4; ++k) {
+      inverseMass[k] = inverseMasses[contact.vertices[k]];
+      effectiveInverseMass += contact.weights[k] * contact.weights[k] * inverseMass[k];
+    }
+  }
   const Real normalSpeed = relative.dot(contact.normal);
   if (normalSpeed >= targetNormalSpeed) return;
   const Real normalChange = targetNormalSpeed - normalSpeed;

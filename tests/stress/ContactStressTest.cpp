@@ -119,14 +119,16 @@ TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
   // The stack went through: every sheet's centre vertex is below the ring.
   const std::span<const Vec3> x = world.positions(cloth).value();
   for (int layer = 0; layer < 3; ++layer) EXPECT_LT(x[layer * 121 + 60].y(), 0.3) << "sheet " << layer;
+  // The collider response follows each vertex's path relative to the body, and the
+  // self-collision's clamp uses the same test, so no layer is pushed back into the pusher.
+  EXPECT_GE(deepest, 0.0) << "a vertex went into the pusher sphere";
   monitor.expectPasses("stacked_sheets_through_ring", kCottonStrainLimit,
                        {{StressMonitor::Condition::Strain,
-                         "measured 0.91: the sheets are dragged through a ring 0.36 m across by a "
-                         "kinematic sphere, which nothing can stop; where they jam, they stretch"}});
-  knownEngineFailure(deepest >= 0, "no vertex inside the pusher sphere",
-                     "measured up to 8.9 mm deep: the self-collision pass runs after the collider "
-                     "response and can push a layer pressed between the sphere and the others "
-                     "back into the sphere");
+                         "measured 3.69 (0.91 before the path-following collider response): the "
+                         "sheets are dragged through a ring 0.36 m across by a kinematic sphere, "
+                         "which nothing can stop; where they jam, they stretch. At cgTolerance "
+                         "1e-2 the jammed layers gain speed from frame 50 and diverge (not "
+                         "diagnosed)"}});
 }
 
 TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) {
@@ -171,18 +173,17 @@ TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) 
   }
   std::printf("[stress] 250 m/s sphere: sheet %s (first frame behind: %d)\n",
               tunnelledAt < 0 ? "stayed in front" : "TUNNELLED", tunnelledAt);
+  // The collider response follows each vertex's path relative to the body (the face it meets,
+  // not the nearest face at the end pose), in the solve's constraints and after the step.
+  EXPECT_LT(tunnelledAt, 0) << "the sheet must stay in front of the 250 m/s sphere";
   monitor.expectPasses("sphere_250_m_per_s", kCottonStrainLimit,
                        {{StressMonitor::Condition::Strain,
-                         "measured 3.2, a consequence of the tunnelling below (the sheet's middle "
-                         "is caught beside the sphere)"}});
-  knownEngineFailure(
-      tunnelledAt < 0, "the sheet stays in front of the 250 m/s sphere",
-      "the sphere crosses the sheet's plane within one frame; ColliderResponse::constrain() and "
-      "resolve() push a vertex found inside at the end of the step out through the NEAREST face "
-      "at the end pose, which for a body that moved more than its radius in the step is the side "
-      "or far face, so the middle of the sheet ends beside the sphere (z = 0). Pushing it out "
-      "through the face it met along its relative path fixes this scene, but the attempt raised "
-      "the curtain's strain at 1/60 s from 0.195 to 1.26 and was not kept");
+                         "measured 0.80 at the impact (frames 0-1) and 0.1-0.3 while the sheet "
+                         "rests on the sphere: contact with colliders is per vertex, so with a "
+                         "5 cm grid on a 10 cm sphere the edges between vertices on the sphere "
+                         "and vertices beside it cut into it (36 edge midpoints inside at the "
+                         "impact, 12-20 and up to 7 mm deep at rest) and are stretched round it; "
+                         "edge and face contact with colliders is not in the engine"}});
 }
 
 constexpr const char* kHeavyReason =
