@@ -448,6 +448,8 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.bendingAssemblies += report.stages.bendingAssemblies;
     stats.dampingJacobians += report.stages.dampingJacobians;
     stats.frozenVertices += report.selfCollision.frozenVertices;
+    stats.strainLimitIterations += report.strainLimit.iterations;
+    stats.strainLimitEdgesOver += report.strainLimit.edgesOverLimit;
     totalSubsteps += report.substeps;
     stats.contacts += report.contacts;
     stats.selfContacts += report.selfCollision.proximityContacts;
