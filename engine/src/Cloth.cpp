@@ -446,7 +446,6 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
       WEFT_PROFILE_ZONE("strain limit");
       const StrainLimitReport limited = m_strainLimiter->apply(
           m_strainLimitSettings, m_inverseMasses, h, m_positions, m_velocities, *m_tasks);
-      report.strainLimit.passes += limited.passes;
       report.strainLimit.iterations += limited.iterations;
       report.strainLimit.edgesOverLimit += limited.edgesOverLimit;
     }

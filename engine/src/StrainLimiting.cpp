@@ -5,25 +5,13 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 
 namespace weft {
 namespace {
 
-// An edge's test or PCG update costs about what a vertex update does (a few loads, products and
-// at most a square root), so edges use the per-vertex grain: the curtain's 3,670 edges are 2
-// blocks.
+// An edge's test and impulse cost about what a vertex update does (a subtraction, a square root,
+// a few products), so edges use the per-vertex grain: the curtain's 3,670 edges are 2 blocks.
 constexpr TaskSystem::Index kGrainEdges = kGrainVertices;
-
-// The PCG of one projection stops when no active edge's residual excess is above this fraction
-// of the tolerance (relative to its rest length): the rest is left to the next projection.
-constexpr Real kResidualFraction = 0.25;
-
-struct DotAndMax {
-  Real dot = 0;
-  Real max = 0;
-};
 
 }  // namespace
 
@@ -38,7 +26,7 @@ StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
     ++m_incidenceOffsets[edge.vertices[1] + 1];
   }
   for (Index i = 0; i < vertexCount; ++i) m_incidenceOffsets[i + 1] += m_incidenceOffsets[i];
-  // Filled in edge order, so every vertex lists its edges in increasing order: the gathers sum
+  // Filled in edge order, so every vertex lists its edges in increasing order: the gather sums
   // them in an order that does not depend on threads.
   m_incidentEdges.resize(m_incidenceOffsets[vertexCount]);
   std::vector<Index> fill(m_incidenceOffsets.begin(), m_incidenceOffsets.end() - 1);
@@ -46,66 +34,30 @@ StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
     m_incidentEdges[fill[m_edges[e].a]++] = e;
     m_incidentEdges[fill[m_edges[e].b]++] = e;
   }
-  const std::size_t edgeCount = m_edges.size();
-  m_active.assign(edgeCount, 0);
-  m_direction.assign(edgeCount, Vec3::Zero());
-  for (std::vector<Real>* scalars : {&m_diagonal, &m_multiplier, &m_residual, &m_preconditioned,
-                                     &m_search, &m_product}) {
-    scalars->assign(edgeCount, 0);
-  }
-  m_shift.assign(vertexCount, Vec3::Zero());
-}
-
-template <class Scalars>
-void StrainLimiter::gatherShifts(const Scalars& s, std::span<const Real> inverseMasses,
-                                 TaskSystem& tasks) {
-  // Vertex a of an edge moves along its direction (toward b), b against it.
-  tasks.parallelFor(Index(m_shift.size()), kGrainVertices, [&](Index begin, Index end, int) {
-    for (Index i = begin; i < end; ++i) {
-      Vec3 shift = Vec3::Zero();
-      if (inverseMasses[i] > 0) {
-        for (Index k = m_incidenceOffsets[i]; k < m_incidenceOffsets[i + 1]; ++k) {
-          const Index e = m_incidentEdges[k];
-          if (!m_active[e]) continue;
-          const Real amount = s(e);
-          if (m_edges[e].a == i) {
-            shift += amount * m_direction[e];
-          } else {
-            shift -= amount * m_direction[e];
-          }
-        }
-        shift *= inverseMasses[i];
-      }
-      m_shift[i] = shift;
-    }
-  });
+  m_impulses.assign(m_edges.size(), Vec3::Zero());
+  m_overLimit.assign(m_edges.size(), 0);
+  m_correctionCount.assign(vertexCount, 0);
 }
 
 StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
                                        std::span<const Real> inverseMasses, Real h,
                                        std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
-  const Index vertexCount = Index(m_shift.size());
+  const Index vertexCount = Index(m_correctionCount.size());
   assert(x.size() == vertexCount && v.size() == vertexCount && inverseMasses.size() == vertexCount &&
          "StrainLimiter::apply: one position, velocity and inverse mass per vertex");
   assert(h > 0 && settings.limit > 0 && std::isfinite(settings.limit) &&
          "StrainLimiter::apply: needs h > 0 and a finite limit > 0 (0 or infinity means off: "
          "do not call)");
-  (void)vertexCount;
   const Real stretchFactor = 1 + settings.limit;
   const Real tolerantFactor = 1 + settings.limit + settings.tolerance;
-  const Real residualTolerance = kResidualFraction * settings.tolerance;
   const Real inverseStep = 1 / h;
   const Index edgeCount = Index(m_edges.size());
-  const auto addCounts = [](Index a, Index b) { return a + b; };
-  const auto addDotKeepMax = [](DotAndMax a, DotAndMax b) {
-    return DotAndMax{a.dot + b.dot, std::max(a.max, b.max)};
-  };
+  const auto sum = [](Index a, Index b) { return a + b; };
 
   StrainLimitReport report;
-  for (int pass = 0;; ++pass) {
-    // Per edge: active when over the limit (or active in an earlier projection) and movable;
-    // its direction, excess (the first residual, with λ = 0; negative for an active edge now
-    // below the limit) and preconditioned residual. Counts the edges over limit + tolerance.
+  for (int iteration = 0;; ++iteration) {
+    // 1. Per edge: the impulse that brings it back to the limit, and the count of edges that
+    //    are still over limit + tolerance (the stopping test).
     const Index over = tasks.parallelReduce(
         edgeCount, kGrainEdges, Index(0),
         [&](Index begin, Index end) {
@@ -116,91 +68,56 @@ StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
             const Vec3 delta = x[edge.b] - x[edge.a];
             const Real length = delta.norm();
             const Real longest = stretchFactor * edge.restLength;
-            m_multiplier[e] = 0;
-            // Once active, an edge stays active for the later projections of this call and is
-            // held at the limit: otherwise the next projection, free to re-stretch it, would
-            // trade it back and forth with its neighbours instead of converging.
-            const bool wasActive = pass > 0 && m_active[e];
-            if ((!(length > longest) && !wasActive) || weightSum == 0 || !(length > 0)) {
-              m_active[e] = 0;
-              m_residual[e] = m_preconditioned[e] = m_search[e] = 0;
+            if (!(length > longest) || weightSum == 0) {
+              m_overLimit[e] = 0;
               continue;
             }
-            m_active[e] = 1;
-            m_direction[e] = delta / length;
-            m_diagonal[e] = weightSum;
-            m_residual[e] = length - longest;
-            m_preconditioned[e] = m_search[e] = m_residual[e] / weightSum;
+            m_overLimit[e] = 1;
+            m_impulses[e] = ((length - longest) / (weightSum * length)) * delta;
             blockOver += length > tolerantFactor * edge.restLength;
           }
           return blockOver;
         },
-        addCounts);
+        sum);
     report.edgesOverLimit = over;
-    if (std::getenv("SLDEBUG")) { Real mx=0; for (Index e=0;e<edgeCount;++e) mx=std::max(mx,(x[m_edges[e].b]-x[m_edges[e].a]).norm()/m_edges[e].restLength-1); std::fprintf(stderr,"pass %d over %u maxstrain %.6f iters %d\n",pass,over,mx,report.iterations);}
-    if (over == 0 || pass == settings.maxPasses) break;
-    report.passes = pass + 1;
+    if (over == 0 || iteration == settings.maxIterations) break;
+    report.iterations = iteration + 1;
 
-    // PCG on J W Jᵀ λ = c over the active edges, from λ = 0.
-    Real residualDotPreconditioned = tasks.parallelReduce(
-        edgeCount, kGrainEdges, Real(0),
-        [&](Index begin, Index end) {
-          Real dot = 0;
-          for (Index e = begin; e < end; ++e) dot += m_residual[e] * m_preconditioned[e];
-          return dot;
-        },
-        [](Real a, Real b) { return a + b; });
-    Real searchFactor = 0;  // β of the previous iteration; the search direction is updated lazily
-    for (int iteration = 0; iteration < settings.maxIterations; ++iteration) {
-      ++report.iterations;
-      // s = z + β s, read on the fly by the vertices and stored by the product pass below.
-      const Real beta = searchFactor;
-      gatherShifts([&](Index e) { return m_preconditioned[e] + beta * m_search[e]; },
-                   inverseMasses, tasks);
-      const Real searchDotProduct = tasks.parallelReduce(
-          edgeCount, kGrainEdges, Real(0),
-          [&](Index begin, Index end) {
-            Real dot = 0;
-            for (Index e = begin; e < end; ++e) {
-              if (!m_active[e]) continue;
-              m_search[e] = m_preconditioned[e] + beta * m_search[e];
-              m_product[e] = m_direction[e].dot(m_shift[m_edges[e].a] - m_shift[m_edges[e].b]);
-              dot += m_search[e] * m_product[e];
-            }
-            return dot;
-          },
-          [](Real a, Real b) { return a + b; });
-      if (!(searchDotProduct > 0)) break;  // nothing left to reduce (or round-off took over)
-      const Real alpha = residualDotPreconditioned / searchDotProduct;
-      const DotAndMax next = tasks.parallelReduce(
-          edgeCount, kGrainEdges, DotAndMax{},
-          [&](Index begin, Index end) {
-            DotAndMax block;
-            for (Index e = begin; e < end; ++e) {
-              if (!m_active[e]) continue;
-              m_multiplier[e] += alpha * m_search[e];
-              m_residual[e] -= alpha * m_product[e];
-              m_preconditioned[e] = m_residual[e] / m_diagonal[e];
-              block.dot += m_residual[e] * m_preconditioned[e];
-              block.max = std::max(block.max, std::abs(m_residual[e]) / m_edges[e].restLength);
-            }
-            return block;
-          },
-          addDotKeepMax);
-      if (next.max <= residualTolerance) break;
-      searchFactor = next.dot / residualDotPreconditioned;
-      residualDotPreconditioned = next.dot;
-    }
-
-    // Move by the multipliers, as a velocity change over the step. A negative one holds an edge
-    // at the limit that the others would have shortened below it; clamping it to 0 instead
-    // would unbalance the large opposite multipliers that redundant edges (a triangle's three)
-    // can carry, and throw vertices far off.
-    gatherShifts([&](Index e) { return m_multiplier[e]; }, inverseMasses, tasks);
-    tasks.parallelFor(Index(m_shift.size()), kGrainVertices, [&](Index begin, Index end, int) {
+    // 2. Per vertex: how many over-limit edges move it (none for a vertex that cannot move).
+    tasks.parallelFor(vertexCount, kGrainVertices, [&](Index begin, Index end, int) {
       for (Index i = begin; i < end; ++i) {
-        x[i] += m_shift[i];
-        v[i] += inverseStep * m_shift[i];
+        Index count = 0;
+        if (inverseMasses[i] > 0) {
+          for (Index k = m_incidenceOffsets[i]; k < m_incidenceOffsets[i + 1]; ++k) {
+            count += Index(m_overLimit[m_incidentEdges[k]]);
+          }
+        }
+        m_correctionCount[i] = count;
+      }
+    });
+
+    // 3. Per vertex: gather the corrections in edge order; each edge's share is divided by the
+    //    larger count of its two ends, the same on both sides, so momentum is unchanged.
+    tasks.parallelFor(vertexCount, kGrainVertices, [&](Index begin, Index end, int) {
+      for (Index i = begin; i < end; ++i) {
+        if (m_correctionCount[i] == 0) continue;
+        Vec3 shift = Vec3::Zero();
+        for (Index k = m_incidenceOffsets[i]; k < m_incidenceOffsets[i + 1]; ++k) {
+          const Index e = m_incidentEdges[k];
+          if (!m_overLimit[e]) continue;
+          const LimitedEdge& edge = m_edges[e];
+          const Real share =
+              Real(1) / Real(std::max(m_correctionCount[edge.a], m_correctionCount[edge.b]));
+          // The impulse points from a to b: a moves along it, b against it.
+          if (edge.a == i) {
+            shift += share * m_impulses[e];
+          } else {
+            shift -= share * m_impulses[e];
+          }
+        }
+        shift *= inverseMasses[i];
+        x[i] += shift;
+        v[i] += inverseStep * shift;
       }
     });
   }

@@ -20,29 +20,31 @@
 // keeps its momentum, and only pins and attachments take force from the cloth. An edge whose
 // two ends are both immovable cannot be corrected and is left alone.
 //
-// The edges over the limit are corrected together, as one linear system (the "fast projection"
-// of Goldenthal et al. 2007 on the active edges): with per-edge multipliers λ, vertex a moves by
-// w_a Σ λ_e n_e and b by −w_b Σ λ_e n_e, and the linearised shortening of every active edge is
-// (J W Jᵀ λ)_e, which must equal its excess c_e. J W Jᵀ is symmetric positive (semi)definite,
-// with diagonal w_a + w_b: it is solved by PCG with that diagonal as preconditioner, and the
-// projection is repeated (a few passes) from the corrected positions for the nonlinearity and for
-// edges the correction itself pushed over; an edge once active stays active (held at the limit)
-// for the rest of the call, so the passes converge like Newton's method instead of trading
-// edges back and forth. λ < 0 is kept: it holds an over-stretched edge at the
-// limit where the others would have shortened it further, which costs nothing, while clamping
-// it to 0 unbalances the large opposite multipliers of redundant edges (measured: a randomly
-// displaced grid went from strain 0.7 to 42).
-// Rejected: Jacobi or Gauss–Seidel sweeps over single edges (Provot's own method). Measured
-// here with a 1 kg weight on a 9 × 9 cotton sheet (vertices of 0.3 g): a sweep moves the weight
-// by w_weight / (w_weight + w_sheet) ≈ 1/3000 of an edge's excess, so after 3,700 Jacobi
-// iterations the sheet was still at strain 0.44. PCG on J W Jᵀ converges at the rate of the
-// light sheet's own graph, whatever the weight.
+// Parallel and deterministic (Jacobi, not Gauss–Seidel): one iteration is
+//   1. per edge (one writer per edge slot): its impulse p_e and whether it is over the limit,
+//      counting the edges still over limit + tolerance (TaskSystem's ordered reduction);
+//   2. per vertex: n_i, how many over-limit edges move vertex i;
+//   3. per vertex (one writer per vertex, incident edges gathered in increasing edge order):
+//      Δx_i = w_i Σ_e ±p_e / max(n_a(e), n_b(e)); x_i += Δx_i, v_i += Δx_i / h.
+// The division by the larger count is the same for both ends of an edge, so every edge still
+// changes momentum by zero, and a vertex pulled by several edges at once takes at most the
+// average of their corrections, which keeps the simultaneous updates from overshooting
+// (Jacobi with every correction in full oscillates on a grid vertex pulled by six edges).
+// Rejected: Gauss–Seidel in edge order (serial, or racy and thread-dependent in parallel); edge
+// colouring (one fork/join per colour per iteration and a colouring to keep); per-vertex
+// averaging by the vertex's own count (conserves momentum only when both ends of every edge
+// have the same count); a global projection (PCG on J W Jᵀ λ = excess over the edges over the
+// limit, Goldenthal et al. 2007): tried, and on a hanging sheet its equality system over a
+// triangle mesh with pinned rows became inconsistent (more active edges than free degrees of
+// freedom), the multipliers grew without bound and the sheet blew up to strain 7 — with or
+// without clamping λ ≥ 0 and a regularised diagonal.
+// Known limit: a free pair shares its correction in inverse proportion to mass, so a vertex
+// much heavier than its neighbours (a 1 kg weight on 0.3 g cotton vertices) moves by a tiny
+// fraction per iteration; within the iteration cap the light cloth around it is held but the
+// weight keeps sinking (measured: strain 0.22 at 0.5 kg, 0.44 at 1 kg on a 9 × 9 sheet).
 //
-// Parallel and deterministic: every pass is either per edge (one writer per edge slot) or per
-// vertex (one writer per vertex, incident edges gathered in increasing edge order), and every
-// dot product is TaskSystem's ordered reduction over fixed blocks. So 1, 2 or 8 threads give the
-// same bits. No Gauss–Seidel, no atomics, no colouring.
-//
+// The iteration stops when no correctable edge is over limit + tolerance, or after
+// maxIterations; the report says how many iterations ran and how many edges were left over.
 // It runs after the solve and before collision response, so collisions keep the last word
 // (nothing inside a collider, no crossing) even where that costs a little strain.
 #pragma once
@@ -64,16 +66,13 @@ struct StrainLimitSettings {
   /// Strain an edge may stay above `limit` when the iteration stops: the corrections aim at the
   /// limit itself, and Jacobi approaches it geometrically, so a small band saves iterations.
   Real tolerance = 1e-3;
-  /// Projections per step at most (each finds the edges over the limit and solves for them).
-  int maxPasses = 4;
-  /// PCG iterations per projection at most (three parallel passes each).
-  int maxIterations = 50;
+  /// Iterations per step at most (three parallel passes each); the report says what was left.
+  int maxIterations = 32;
 };
 
 /// What one StrainLimiter::apply() did.
 struct StrainLimitReport {
-  int passes = 0;          ///< projections run (0: no edge was over limit + tolerance)
-  int iterations = 0;      ///< PCG iterations summed over the projections
+  int iterations = 0;      ///< correction passes run (0: no edge was over limit + tolerance)
   Index edgesOverLimit = 0;  ///< correctable edges still over limit + tolerance at the end
 };
 
@@ -86,7 +85,7 @@ class StrainLimiter {
 
   /// Corrects x and v (one entry per vertex) after a step of length h > 0 so that no edge with
   /// a movable end is longer than (1 + settings.limit) times its rest length (to the tolerance,
-  /// within settings.maxPasses and maxIterations). `inverseMasses` is 1/m per vertex, 0 for vertices that must
+  /// within settings.maxIterations). `inverseMasses` is 1/m per vertex, 0 for vertices that must
   /// not move. Bitwise the same for any thread count of `tasks`.
   StrainLimitReport apply(const StrainLimitSettings& settings, std::span<const Real> inverseMasses,
                           Real h, std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks);
@@ -96,19 +95,13 @@ class StrainLimiter {
     Index a = 0, b = 0;
     Real restLength = 0;
   };
-  // y = J W Jᵀ s on the active edges (the product of one PCG iteration), via m_shift.
-  template <class Scalars>
-  void gatherShifts(const Scalars& s, std::span<const Real> inverseMasses, TaskSystem& tasks);
-
   std::vector<LimitedEdge> m_edges;
   // Incident edges of every vertex, in increasing edge order: vertex i's are
   // m_incidentEdges[m_incidenceOffsets[i] .. m_incidenceOffsets[i + 1]).
   std::vector<Index> m_incidenceOffsets, m_incidentEdges;
-  // Per edge: active in this projection, its direction, and the PCG vectors (0 when inactive).
-  std::vector<char> m_active;
-  std::vector<Vec3> m_direction;
-  std::vector<Real> m_diagonal, m_multiplier, m_residual, m_preconditioned, m_search, m_product;
-  std::vector<Vec3> m_shift;  // per vertex: W Jᵀ s for the current s
+  std::vector<Vec3> m_impulses;          // per edge: p_e (stale when not over the limit)
+  std::vector<char> m_overLimit;         // per edge: 1 when corrected this iteration
+  std::vector<Index> m_correctionCount;  // per vertex: n_i of this iteration
 };
 
 }  // namespace weft
