@@ -85,6 +85,16 @@ std::string checkPositive(const char* field, Real value, const char* unit) {
   return text.str();
 }
 
+// 0 and +infinity both mean "no limit"; NaN and negatives are mistakes.
+std::string checkStrainLimit(Real value) {
+  if (value >= 0) return {};
+  std::ostringstream text;
+  text << "material.strainLimit = " << value
+       << " (strain l / l_rest - 1): must be at least 0; use 0 or infinity to turn strain "
+          "limiting off";
+  return text.str();
+}
+
 std::string validate(const ClothModel* model, const ClothSettings& settings) {
   if (!model) return "ClothModel is null: build one with ClothModel::grid() or fromMesh()";
   const ClothMaterial& m = settings.material;
@@ -104,6 +114,7 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
            checkNonNegative("material.airDrag", m.airDrag, "N·s/m³"),
            checkPositive("material.thickness", m.thickness, "m"),
            checkNonNegative("material.friction", m.friction, ""),
+           checkStrainLimit(m.strainLimit),
            checkNonNegative("springs.structuralStiffness", s.structuralStiffness, "N/m"),
            checkNonNegative("springs.shearStiffness", s.shearStiffness, "N/m"),
            checkNonNegative("springs.flexionStiffness", s.flexionStiffness, "N/m"),
@@ -222,6 +233,11 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
     // (the self-collision results are the same bits either way; see Bvh.h).
     m_selfCollision->setRefitSkipping(
         world.skipUnneededStages ? kBvhRefitMotionPerThickness * settings.material.thickness : -1);
+  }
+  const Real strainLimit = settings.material.strainLimit;
+  if (strainLimit > 0 && std::isfinite(strainLimit)) {
+    m_strainLimiter = std::make_unique<StrainLimiter>(m_model->edges(), n);
+    m_strainLimitSettings.limit = strainLimit;
   }
   m_skipStages = world.skipUnneededStages;
   estimateStiffestMode();
@@ -480,6 +496,14 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
       m_stepStartVelocities = m_velocities;
     }
     m_integrator->step(*this, m_positions, m_velocities, t + substep * h, h, substepReport);
+    if (m_strainLimiter) {
+      // After the solve, before the collision passes: they keep the last word.
+      WEFT_PROFILE_ZONE("strain limit");
+      const StrainLimitReport limited = m_strainLimiter->apply(
+          m_strainLimitSettings, m_inverseMasses, h, m_positions, m_velocities, *m_tasks);
+      report.strainLimit.iterations += limited.iterations;
+      report.strainLimit.edgesOverLimit += limited.edgesOverLimit;
+    }
     if (!colliders.empty()) {
       // The response tests the end positions and the segments from the (carried) start points.
       Aabb end = Aabb::empty(), start = Aabb::empty();
@@ -715,6 +739,7 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
   for (int attempt = 0;; ++attempt) {
     report.substeps = substeps;
     report.integrator = IntegratorReport{};
+    report.strainLimit = StrainLimitReport{};
     HealthFailure failure = runSubsteps(t, frameDt, substeps, colliders, report);
     if (failure == HealthFailure::None) {
       WEFT_PROFILE_ZONE("health");

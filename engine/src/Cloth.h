@@ -9,6 +9,7 @@
 #include "ColliderResponse.h"
 #include "FoldCulling.h"
 #include "SelfCollision.h"
+#include "StrainLimiting.h"
 #include "integrators/Integrator.h"
 #include "solver/BlockSparseMatrix.h"
 #include "solver/FreeVertexMap.h"
@@ -43,6 +44,9 @@ struct ClothFrameReport {
   SelfCollisionReport selfCollision;  ///< summed over substeps
   Index contacts = 0;  ///< vertices touching colliders at the end of the frame
   IntegratorReport integrator;
+  /// Strain-limiter iterations and edges left over the limit, summed over the substeps of the
+  /// frame's last attempt.
+  StrainLimitReport strainLimit;
   StepStatus status = StepStatus::Ok;
   HealthFailure healthFailure = HealthFailure::None;  ///< why the last failed attempt failed
   Real maxStrain = 0;      ///< Cloth::maxStrain() at the end of the frame
@@ -191,6 +195,9 @@ class Cloth final : public DynamicSystem {
   ColliderResponse m_colliderResponse;
   std::unique_ptr<SelfCollision> m_selfCollision;  // null when ClothSettings::selfCollision is off
   std::unique_ptr<FoldCulling> m_foldCulling;      // with m_selfCollision
+  // Null when ClothMaterial::strainLimit is 0 or infinite (off).
+  std::unique_ptr<StrainLimiter> m_strainLimiter;
+  StrainLimitSettings m_strainLimitSettings;
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
   ClothStageCounters m_stages;                     // this frame's

@@ -20,6 +20,10 @@
 // Thickness is the collision margin (ClothMaterial::thickness), not the caliper thickness of the
 // fabric (KES T ≈ 0.3–1.1 mm); it grows with the fabric's weight [EST]. Friction is the
 // cloth-on-cloth Coulomb coefficient, 0.2 (silk) to 0.35 (wool, linen, denim) [EST].
+// Strain limit (ClothMaterial::strainLimit): where the fabric leaves the low-strain regime its
+// stretch stiffness was fitted in and its straightened yarns make it nearly inextensible. Woven
+// fabrics reach that at a few to ~10 % (Provot 1995 uses 10 %); crimped wool a little later,
+// tightly woven heavy twill and flax earlier. All [EST]: neither source measures it.
 #include <weft/engine/FabricPresets.h>
 
 #include <array>
@@ -40,7 +44,7 @@ constexpr Real kShearFromKes = 0.980665 * 180.0 / 3.14159265358979323846;
 
 // A material from its measured (or estimated) stiffnesses, damped like the curtain.
 ClothMaterial makeFabric(Real arealDensity, Real warpStretch, Real weftStretch, Real shear,
-                         Real bending, Real friction, Real thickness) {
+                         Real bending, Real friction, Real thickness, Real strainLimit) {
   ClothMaterial material;
   material.arealDensity = arealDensity;
   material.warpStretchStiffness = warpStretch;
@@ -53,6 +57,7 @@ ClothMaterial makeFabric(Real arealDensity, Real warpStretch, Real weftStretch, 
   material.bendingDamping = kBendingDampingTime * bending;
   material.friction = friction;
   material.thickness = thickness;
+  material.strainLimit = strainLimit;
   return material;
 }
 
@@ -77,7 +82,8 @@ ClothMaterial cottonFabric() {
   // In KES terms: 0.15 kg/m² is a 150 g/m² shirting; D = 2.3e-6 N·m is B ≈ 0.023 gf·cm²/cm (a
   // light lawn; shirting is 0.05–0.1) [KES]; 100 N/m shear is G ≈ 1.8 gf/(cm·deg) [KES];
   // 260 N/m stretch lies within [W11]'s low-strain slopes (2·C: 33 N/m for the cotton/polyester
-  // interlock up to 2028 N/m for the denim weft).
+  // interlock up to 2028 N/m for the denim weft). Strain limit 0.10: plain-woven cotton's
+  // low-strain regime ends at about 10 % [EST, Provot 1995's threshold].
   return ClothMaterial{};
 }
 
@@ -88,7 +94,8 @@ ClothMaterial woolFabric() {
                     0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, suiting]
                     0.10 * kBendingFromKes,   // B ≈ 0.10 gf·cm²/cm → 9.8e-6 N·m [KES, suiting]
                     0.35,    // [EST]
-                    0.004);  // m [EST]
+                    0.004,   // m [EST]
+                    0.15);   // strain [EST]: crimped wool yarns straighten before they extend
 }
 
 ClothMaterial polyesterFabric() {
@@ -98,7 +105,8 @@ ClothMaterial polyesterFabric() {
                     0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, polyester]
                     0.05 * kBendingFromKes,   // B ≈ 0.05 gf·cm²/cm → 4.9e-6 N·m [KES, polyester]
                     0.25,    // [EST]
-                    0.003);  // m [EST]
+                    0.003,   // m [EST]
+                    0.10);   // strain [EST]: a plain weave, like cotton
 }
 
 ClothMaterial silkFabric() {
@@ -108,7 +116,8 @@ ClothMaterial silkFabric() {
                     0.4 * kShearFromKes,      // G ≈ 0.4 gf/(cm·deg) → 22 N/m [KES, silk]
                     0.015 * kBendingFromKes,  // B ≈ 0.015 gf·cm²/cm → 1.5e-6 N·m [KES, silk]
                     0.2,     // [EST]
-                    0.002);  // m [EST]
+                    0.002,   // m [EST]
+                    0.10);   // strain [EST]: a plain weave, like cotton
 }
 
 ClothMaterial denimFabric() {
@@ -118,7 +127,8 @@ ClothMaterial denimFabric() {
                     2.0 * kShearFromKes,      // G ≈ 2.0 gf/(cm·deg) → 112 N/m [KES, denim 1.5–3.4]
                     0.17 * kBendingFromKes,   // B ≈ 0.17 gf·cm²/cm → 1.7e-5 N·m [KES, 0.14–0.23]
                     0.35,    // [EST]
-                    0.004);  // m [EST]
+                    0.004,   // m [EST]
+                    0.06);   // strain [EST]: a dense twill of heavy yarns, little crimp to give
 }
 
 ClothMaterial linenFabric() {
@@ -128,7 +138,8 @@ ClothMaterial linenFabric() {
                     1.6 * kShearFromKes,      // G ≈ 1.6 gf/(cm·deg) → 90 N/m [KES, linen]
                     0.20 * kBendingFromKes,   // B ≈ 0.20 gf·cm²/cm → 2.0e-5 N·m [KES, linen]
                     0.35,    // [EST]
-                    0.003);  // m [EST]
+                    0.003,   // m [EST]
+                    0.06);   // strain [EST]: flax fibres extend only a few per cent
 }
 
 std::span<const std::string_view> fabricPresetNames() { return kNames; }

@@ -450,6 +450,8 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.bvhNodesRefit += report.stages.bvhNodesRefit;
     stats.bvhNodesSkipped += report.stages.bvhNodesSkipped;
     stats.frozenVertices += report.selfCollision.frozenVertices;
+    stats.strainLimitIterations += report.strainLimit.iterations;
+    stats.strainLimitEdgesOver += report.strainLimit.edgesOverLimit;
     totalSubsteps += report.substeps;
     stats.contacts += report.contacts;
     stats.selfContacts += report.selfCollision.proximityContacts;

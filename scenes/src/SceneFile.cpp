@@ -307,7 +307,7 @@ void readMaterial(Reader& reader, const Json& object, const std::string& path, C
                    {"preset", "arealDensity", "warpStretchStiffness", "weftStretchStiffness",
                     "shearStiffness", "bendingStiffness", "warpRestScale", "weftRestScale",
                     "stretchDamping", "shearDamping", "bendingDamping", "airDrag", "thickness",
-                    "friction"});
+                    "friction", "strainLimit"});
   std::string preset;
   if (reader.readString(object, path, "preset", preset) && Reader::member(object, "preset")) {
     Result<ClothMaterial> material = fabricPreset(preset);
@@ -327,6 +327,8 @@ void readMaterial(Reader& reader, const Json& object, const std::string& path, C
   reader.readReal(object, path, "airDrag", m.airDrag, Range::NonNegative, "N·s/m³");
   reader.readReal(object, path, "thickness", m.thickness, Range::Positive, "m");
   reader.readReal(object, path, "friction", m.friction, Range::NonNegative, "Coulomb coefficient");
+  reader.readReal(object, path, "strainLimit", m.strainLimit, Range::NonNegative,
+                  "strain l / l_rest - 1 (0 = off)");
 }
 
 void readSprings(Reader& reader, const Json& object, const std::string& path, MassSpringMaterial& m) {

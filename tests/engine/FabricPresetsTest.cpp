@@ -35,6 +35,8 @@ TEST(FabricPresets, CottonIsTheCurtainMaterial) {
   EXPECT_EQ(cotton.airDrag, defaults.airDrag);
   EXPECT_EQ(cotton.thickness, defaults.thickness);
   EXPECT_EQ(cotton.friction, defaults.friction);
+  EXPECT_EQ(cotton.strainLimit, defaults.strainLimit);
+  EXPECT_EQ(cotton.strainLimit, 0.10);
 }
 
 TEST(FabricPresets, EveryNameGivesAMaterialTheWorldAccepts) {
@@ -53,6 +55,8 @@ TEST(FabricPresets, EveryNameGivesAMaterialTheWorldAccepts) {
     EXPECT_GT(m.bendingStiffness, 0) << name;
     EXPECT_GT(m.shearStiffness, 0) << name;
     EXPECT_NEAR(m.shearDamping / m.shearStiffness, 0.002, 1e-9) << name;
+    EXPECT_GE(m.strainLimit, 0.03) << name;  // woven fabric: a few to ~15 % (FabricPresets.cpp)
+    EXPECT_LE(m.strainLimit, 0.15) << name;
     World world;
     ClothSettings settings;
     settings.material = m;

@@ -4,7 +4,8 @@
 //       then held for 1 s: half a turn in all, which stretches the strip's long edges by about
 //       5 % if it stays flat, and makes it buckle and touch itself if it does not);
 //   10  the pins of a hanging cloth teleported 10 m sideways in one frame: everything stays
-//       finite and the cloth's energy is back to its settled value within 2 s.
+//       finite, the strain is back within the limit 2 s later (the strain limiter), and the
+//       cloth's energy is back to its settled value within 2 s (a known failure).
 #include "stress/StressSupport.h"
 
 #include <Eigen/Geometry>
@@ -58,10 +59,12 @@ TEST(StressPins, StripTwistedByItsTwoPinnedEnds) {
 
 constexpr const char* kTeleportReason =
     "pins move linearly across a frame (World.h), so a 10 m jump in one frame drags the pinned "
-    "row at 600 m/s and the implicit solve hands that velocity to the cloth (9.4e4 J, against "
-    "0.42 J settled); two seconds later the cloth still swings around its pins, stretched to a "
-    "strain of about 2.8. A teleport needs its own path (World::setState moves the whole cloth "
-    "without velocity); the pins have none";
+    "row at 600 m/s. With the strain limiter the cloth is hauled after its pins (strain within "
+    "the limit from frame 120 on), but during the first frames the limiter stops at its "
+    "iteration cap with edges far over (peak strain 98.7, 4 frames retried by the health "
+    "monitor) and the elastic and kinetic energy peak at 1.6e7 J; 3 s later the energy is still "
+    "not back within 1 % of the settled value. A teleport needs its own path (World::setState "
+    "moves the whole cloth without velocity); the pins have none";
 
 TEST(StressPins, PinsTeleportedTenMetresSettleBackWithinTwoSeconds) {
   constexpr Index kColumns = 13, kRows = 9;
@@ -107,8 +110,7 @@ TEST(StressPins, PinsTeleportedTenMetresSettleBackWithinTwoSeconds) {
               "1 %% of m·g·height (%.3g J) after %.3f s\n", peakEnergy, baseline, scale, settledAt);
   // The cloth followed its pins.
   EXPECT_GT(world.positions(cloth).value()[0].x(), 9.0);
-  monitor.expectPasses("teleported_pins", kCottonStrainLimit,
-                       {{StressMonitor::Condition::Strain, kTeleportReason}});
+  monitor.expectPasses("teleported_pins");
   knownEngineFailure(settledAt >= 0 && settledAt <= 2.0, "energy back to the settled value within 2 s",
                      kTeleportReason);
 }

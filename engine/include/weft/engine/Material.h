@@ -40,6 +40,12 @@ struct ClothMaterial {
   Real airDrag = 0.1;                 ///< N·s/m³, linear drag per area on velocity relative to air
   Real thickness = 0.003;             ///< m, contact thickness (collision)
   Real friction = 0.3;                ///< Coulomb friction coefficient (collision)
+  /// Strain l / l_rest − 1 that no mesh edge may exceed at the end of a step: the strain
+  /// limiter (Provot 1995, Bridson et al. 2002) corrects each step's velocities after the solve,
+  /// before collisions, which keep the last word. 0 or infinity turns it off. Woven fabric
+  /// leaves its low-strain regime, where the stretch stiffness above holds, at about 10 %: past
+  /// it the yarns are straight and the cloth is nearly inextensible. Lower = stiffer feel.
+  Real strainLimit = 0.10;
 };
 
 /// The classic mass-spring network (Provot 1995): one stiffness per spring family.

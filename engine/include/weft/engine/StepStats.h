@@ -82,6 +82,14 @@ struct StepStats {
   /// impact zones did not clear their contacts (all substeps): the contacts the engine did not
   /// resolve physically. They never cross; they stop instead.
   Index frozenVertices = 0;
+  /// Strain-limiter iterations (ClothMaterial::strainLimit), summed over cloths and substeps;
+  /// 0 when no edge went over its cloth's limit (or every limit is off).
+  int strainLimitIterations = 0;
+  /// Edges the strain limiter left over limit + 0.001 after its last iteration (it stopped at
+  /// its iteration cap), summed over cloths and substeps; edges with both ends pinned are not
+  /// counted (nothing can shorten them). Collisions run after the limiter and may stretch edges
+  /// a little more: StepStats::maxStrain is what the frame ended with.
+  Index strainLimitEdgesOver = 0;
 
   // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
   Real budgetMs = 0;           ///< ms, the budget this frame was given (0 = none)

@@ -1,0 +1,127 @@
+#include "StrainLimiting.h"
+
+#include <weft/threading/GrainSizes.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+namespace weft {
+namespace {
+
+// An edge's test and impulse cost about what a vertex update does (a subtraction, a square root,
+// a few products), so edges use the per-vertex grain: the curtain's 3,670 edges are 2 blocks.
+constexpr TaskSystem::Index kGrainEdges = kGrainVertices;
+
+}  // namespace
+
+StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
+  m_edges.reserve(edges.size());
+  m_incidenceOffsets.assign(std::size_t(vertexCount) + 1, 0);
+  for (const Edge& edge : edges) {
+    assert(edge.vertices[0] < vertexCount && edge.vertices[1] < vertexCount &&
+           "StrainLimiter: edge vertex outside the mesh; pass the model's vertexCount()");
+    m_edges.push_back(LimitedEdge{edge.vertices[0], edge.vertices[1], edge.restLength});
+    ++m_incidenceOffsets[edge.vertices[0] + 1];
+    ++m_incidenceOffsets[edge.vertices[1] + 1];
+  }
+  for (Index i = 0; i < vertexCount; ++i) m_incidenceOffsets[i + 1] += m_incidenceOffsets[i];
+  // Filled in edge order, so every vertex lists its edges in increasing order: the gather sums
+  // them in an order that does not depend on threads.
+  m_incidentEdges.resize(m_incidenceOffsets[vertexCount]);
+  std::vector<Index> fill(m_incidenceOffsets.begin(), m_incidenceOffsets.end() - 1);
+  for (Index e = 0; e < Index(m_edges.size()); ++e) {
+    m_incidentEdges[fill[m_edges[e].a]++] = e;
+    m_incidentEdges[fill[m_edges[e].b]++] = e;
+  }
+  m_impulses.assign(m_edges.size(), Vec3::Zero());
+  m_overLimit.assign(m_edges.size(), 0);
+  m_correctionCount.assign(vertexCount, 0);
+}
+
+StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
+                                       std::span<const Real> inverseMasses, Real h,
+                                       std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
+  const Index vertexCount = Index(m_correctionCount.size());
+  assert(x.size() == vertexCount && v.size() == vertexCount && inverseMasses.size() == vertexCount &&
+         "StrainLimiter::apply: one position, velocity and inverse mass per vertex");
+  assert(h > 0 && settings.limit > 0 && std::isfinite(settings.limit) &&
+         "StrainLimiter::apply: needs h > 0 and a finite limit > 0 (0 or infinity means off: "
+         "do not call)");
+  const Real stretchFactor = 1 + settings.limit;
+  const Real tolerantFactor = 1 + settings.limit + settings.tolerance;
+  const Real inverseStep = 1 / h;
+  const Index edgeCount = Index(m_edges.size());
+  const auto sum = [](Index a, Index b) { return a + b; };
+
+  StrainLimitReport report;
+  for (int iteration = 0;; ++iteration) {
+    // 1. Per edge: the impulse that brings it back to the limit, and the count of edges that
+    //    are still over limit + tolerance (the stopping test).
+    const Index over = tasks.parallelReduce(
+        edgeCount, kGrainEdges, Index(0),
+        [&](Index begin, Index end) {
+          Index blockOver = 0;
+          for (Index e = begin; e < end; ++e) {
+            const LimitedEdge& edge = m_edges[e];
+            const Real weightSum = inverseMasses[edge.a] + inverseMasses[edge.b];
+            const Vec3 delta = x[edge.b] - x[edge.a];
+            const Real length = delta.norm();
+            const Real longest = stretchFactor * edge.restLength;
+            if (!(length > longest) || weightSum == 0) {
+              m_overLimit[e] = 0;
+              continue;
+            }
+            m_overLimit[e] = 1;
+            m_impulses[e] = ((length - longest) / (weightSum * length)) * delta;
+            blockOver += length > tolerantFactor * edge.restLength;
+          }
+          return blockOver;
+        },
+        sum);
+    report.edgesOverLimit = over;
+    if (over == 0 || iteration == settings.maxIterations) break;
+    report.iterations = iteration + 1;
+
+    // 2. Per vertex: how many over-limit edges move it (none for a vertex that cannot move).
+    tasks.parallelFor(vertexCount, kGrainVertices, [&](Index begin, Index end, int) {
+      for (Index i = begin; i < end; ++i) {
+        Index count = 0;
+        if (inverseMasses[i] > 0) {
+          for (Index k = m_incidenceOffsets[i]; k < m_incidenceOffsets[i + 1]; ++k) {
+            count += Index(m_overLimit[m_incidentEdges[k]]);
+          }
+        }
+        m_correctionCount[i] = count;
+      }
+    });
+
+    // 3. Per vertex: gather the corrections in edge order; each edge's share is divided by the
+    //    larger count of its two ends, the same on both sides, so momentum is unchanged.
+    tasks.parallelFor(vertexCount, kGrainVertices, [&](Index begin, Index end, int) {
+      for (Index i = begin; i < end; ++i) {
+        if (m_correctionCount[i] == 0) continue;
+        Vec3 shift = Vec3::Zero();
+        for (Index k = m_incidenceOffsets[i]; k < m_incidenceOffsets[i + 1]; ++k) {
+          const Index e = m_incidentEdges[k];
+          if (!m_overLimit[e]) continue;
+          const LimitedEdge& edge = m_edges[e];
+          const Real share =
+              Real(1) / Real(std::max(m_correctionCount[edge.a], m_correctionCount[edge.b]));
+          // The impulse points from a to b: a moves along it, b against it.
+          if (edge.a == i) {
+            shift += share * m_impulses[e];
+          } else {
+            shift -= share * m_impulses[e];
+          }
+        }
+        shift *= inverseMasses[i];
+        x[i] += shift;
+        v[i] += inverseStep * shift;
+      }
+    });
+  }
+  return report;
+}
+
+}  // namespace weft
