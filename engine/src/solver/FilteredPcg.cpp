@@ -1,6 +1,7 @@
 // FilteredPcg: BW98 §5.3 modified PCG. See the design note in the header for the method, the
 // stopping rule and the determinism scheme; the kernels below are the per-range sweeps it runs.
 #include <solver/FilteredPcg.h>
+#include <solver/MulticolorOrdering.h>
 
 #include <algorithm>
 #include <cmath>
@@ -114,7 +115,10 @@ Real filteredProductRange(Index begin, Index end, const BlockSparseMatrix& A,
   return sum;
 }
 
-/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs.
+/// Δv += α c, r −= α q over the range; returns Σ rᵀD̃⁻¹r (the stopping norm², D̃⁻¹ the filtered
+/// block-Jacobi inverse). With storeJacobi, also s = D̃⁻¹ r (the block-Jacobi preconditioner);
+/// without, s is left to the Gauss–Seidel sweeps.
+template <bool storeJacobi>
 Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const Vec3Array& q,
                  const std::vector<Mat3>& inverseDiagonal, Vec3Array& deltaV, Vec3Array& r,
                  Vec3Array& s) {
@@ -122,10 +126,57 @@ Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const V
   for (Index vertex = begin; vertex < end; ++vertex) {
     deltaV[vertex] += alpha * c[vertex];
     r[vertex] -= alpha * q[vertex];
-    s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
-    sum += r[vertex].dot(s[vertex]);
+    const Vec3 jacobi = inverseDiagonal[vertex] * r[vertex];
+    if constexpr (storeJacobi) s[vertex] = jacobi;
+    sum += r[vertex].dot(jacobi);
   }
   return sum;
+}
+
+/// Σ rᵀz over the range.
+Real dotRange(Index begin, Index end, const Vec3Array& r, const Vec3Array& z) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) sum += r[vertex].dot(z[vertex]);
+  return sum;
+}
+
+/// Forward Gauss–Seidel sweep over the vertices order[begin … end) of one colour:
+/// z_i = S_i D̃_i⁻¹ (r_i − Σ_{colour(j) < colour(i)} A_ij z_j). The z_j read belong to earlier
+/// colours, which are complete; vertices of one colour share no block, so they can run in any
+/// order or at once. S_i on the output keeps z exactly in the free subspace (exact zeros for
+/// fixed vertices, whatever their rows hold).
+void forwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
+                       const MulticolorOrdering& ordering, const VertexFilter& filter,
+                       const std::vector<Mat3>& inverseDiagonal, const Vec3Array& r, Vec3Array& z) {
+  const std::vector<Index>& order = ordering.order();
+  const std::vector<Index>& lower = ordering.lowerSlots();
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = order[k];
+    Vec3 sum = r[vertex];
+    for (Index t = ordering.lowerBegin(vertex), last = ordering.lowerBegin(vertex + 1); t < last; ++t) {
+      const Index slot = lower[t];
+      sum.noalias() -= A.block(slot) * z[A.column(slot)];
+    }
+    z[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * sum);
+  }
+}
+
+/// Backward sweep over one colour: z_i ← S_i (z_i − D̃_i⁻¹ Σ_{colour(j) > colour(i)} A_ij z_j),
+/// the later colours being final already (the sweep runs the colours in reverse).
+void backwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
+                        const MulticolorOrdering& ordering, const VertexFilter& filter,
+                        const std::vector<Mat3>& inverseDiagonal, Vec3Array& z) {
+  const std::vector<Index>& order = ordering.order();
+  const std::vector<Index>& upper = ordering.upperSlots();
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = order[k];
+    Vec3 sum = Vec3::Zero();
+    for (Index t = ordering.upperBegin(vertex), last = ordering.upperBegin(vertex + 1); t < last; ++t) {
+      const Index slot = upper[t];
+      sum.noalias() += A.block(slot) * z[A.column(slot)];
+    }
+    z[vertex] = filter.filter(vertex, z[vertex] - inverseDiagonal[vertex] * sum);
+  }
 }
 
 /// c = S(s + β c) over the range. s and c are in the free subspace already; filtering again
@@ -169,6 +220,20 @@ Real FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
 }
 
 template <typename Kernel>
+void FilteredPcg::forEachInRange(Index count, Kernel&& kernel) {
+  // parallelFor runs a single block inline (no fork): a colour smaller than a block costs nothing
+  // in task overhead, which matters since a sweep visits every colour twice per iteration.
+  if (m_tasks) {
+    m_tasks->parallelFor(count, kReductionBlock,
+                         [&](Index begin, Index end, int) { kernel(begin, end); });
+    return;
+  }
+  for (Index begin = 0; begin < count; begin += kReductionBlock) {
+    kernel(begin, std::min(begin + kReductionBlock, count));
+  }
+}
+
+template <typename Kernel>
 void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
   if (m_tasks) {
     m_tasks->parallelFor(vertexCount, kReductionBlock,
@@ -178,6 +243,27 @@ void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
   for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
     kernel(begin, std::min(begin + kReductionBlock, vertexCount));
   }
+}
+
+Real FilteredPcg::applyGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                   const Vec3Array& r, Vec3Array& z) {
+  const Index colors = m_ordering.colorCount();
+  // Each colour is cut into fixed blocks of its own vertex list; a block writes only its own
+  // vertices' z and reads other colours' z, so the bits do not depend on which thread runs it.
+  for (Index color = 0; color < colors; ++color) {
+    const Index first = m_ordering.colorBegin(color);
+    forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+      forwardSweepRange(first + begin, first + end, A, m_ordering, filter, m_inverseDiagonal, r, z);
+    });
+  }
+  for (Index color = colors; color-- > 0;) {
+    const Index first = m_ordering.colorBegin(color);
+    forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+      backwardSweepRange(first + begin, first + end, A, m_ordering, filter, m_inverseDiagonal, z);
+    });
+  }
+  return sumOverBlocks(A.blockRows(),
+                       [&](Index begin, Index end) { return dotRange(begin, end, r, z); });
 }
 
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
@@ -207,6 +293,9 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   forEachBlock(vertexCount, [&](Index begin, Index end) {
     buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
   });
+  const bool gaussSeidel = settings.preconditioner == PreconditionerKind::MulticolorGaussSeidel;
+  // The colouring depends on the pattern only: rebuilt (allocating) when the topology changes.
+  if (gaussSeidel && !m_ordering.matches(A)) m_ordering.build(A);
 
   // The reference r_ref = S(b − A(I − S)z). A cold start begins exactly there, so it is the initial
   // residual; a warm start needs it separately, and needs the SpMV only when some target is nonzero.
@@ -229,10 +318,13 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
 
   forEachBlock(vertexCount,
                [&](Index begin, Index end) { startRange(begin, end, filter, warmStart, deltaV); });
-  Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+  // stopDelta = rᵀD̃⁻¹r drives the stopping rule; delta = rᵀs = rᵀP⁻¹r drives CG. They are one
+  // number for block Jacobi (s = D̃⁻¹r).
+  Real stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
     return residualRange(begin, end, A, b, filter, m_inverseDiagonal, deltaV, r, s);
   });
-  if (!warmStart) referenceDelta = delta;
+  if (!warmStart) referenceDelta = stopDelta;
+  Real delta = gaussSeidel ? applyGaussSeidel(A, filter, r, s) : stopDelta;
 
   // rᵀP̃⁻¹r ≥ 0 in exact arithmetic; clamp rounding below zero before the square root.
   const Real referenceNorm = std::sqrt(std::max(referenceDelta, Real(0)));
@@ -246,13 +338,13 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   for (;;) {
     // NaN compares false with everything, so test finiteness first: a NaN residual must end the
     // loop as a failure, never look converged and never spin until the cap.
-    if (!referenceFinite || !std::isfinite(delta)) {
+    if (!referenceFinite || !std::isfinite(delta) || !std::isfinite(stopDelta)) {
       report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
       report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
       report.converged = false;
       break;
     }
-    report.residualNorm = std::sqrt(std::max(delta, Real(0)));
+    report.residualNorm = std::sqrt(std::max(stopDelta, Real(0)));
     // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
     report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
                               : report.residualNorm == 0 ? Real(0)
@@ -283,9 +375,17 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
     }
     const Real alpha = delta / curvature;
     previousDelta = delta;
-    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
-    });
+    if (gaussSeidel) {
+      stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+        return updateRange<false>(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
+      });
+      delta = applyGaussSeidel(A, filter, r, s);
+    } else {
+      stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+        return updateRange<true>(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
+      });
+      delta = stopDelta;
+    }
     ++report.iterations;
   }
   return report;

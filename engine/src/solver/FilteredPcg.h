@@ -41,9 +41,11 @@
 #pragma once
 
 #include <solver/BlockSparseMatrix.h>
+#include <solver/MulticolorOrdering.h>
 #include <solver/VertexFilter.h>
 
 #include <weft/Math.h>
+#include <weft/engine/SolverSettings.h>
 #include <weft/threading/TaskSystem.h>
 
 #include <vector>
@@ -64,6 +66,9 @@ struct PcgSettings {
   /// over the 0.45 kg curtain: far below anything visible, far above double rounding of a typical
   /// step's ‖b‖_{P⁻¹} (~0.1 √kg·m/s for gravity alone). Raising it ends near-static solves sooner.
   Real absoluteTolerance = 1e-12;
+  /// Which preconditioner (SolverSettings::preconditioner). The stopping norm is the block-Jacobi
+  /// one for every kind, so the tolerance means the same accuracy whichever is used.
+  PreconditionerKind preconditioner = PreconditionerKind::BlockJacobi;
 };
 
 /// What one FilteredPcg::solve did.
@@ -110,12 +115,22 @@ class FilteredPcg {
   template <typename Kernel>
   void forEachBlock(Index vertexCount, Kernel&& kernel);
 
+  /// Runs kernel(begin, end) over fixed blocks of [0, count) (a colour's vertex list).
+  template <typename Kernel>
+  void forEachInRange(Index count, Kernel&& kernel);
+
+  /// z = P⁻¹ r for the multicolour symmetric Gauss–Seidel preconditioner (forward sweep over the
+  /// colours, then backward); returns rᵀz, summed in fixed vertex blocks.
+  Real applyGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter, const Vec3Array& r,
+                        Vec3Array& z);
+
   Vec3Array m_residual;          ///< r = S(b − AΔv)
   Vec3Array m_preconditioned;    ///< s = P̃⁻¹ r
   Vec3Array m_direction;         ///< c, the filtered search direction
   Vec3Array m_product;           ///< q = S A c
   std::vector<Mat3> m_inverseDiagonal;  ///< P̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
+  MulticolorOrdering m_ordering;        ///< colouring of A's pattern (Gauss–Seidel only)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
 };
 
