@@ -115,10 +115,7 @@ Real filteredProductRange(Index begin, Index end, const BlockSparseMatrix& A,
   return sum;
 }
 
-/// Δv += α c, r −= α q over the range; returns Σ rᵀD̃⁻¹r (the stopping norm², D̃⁻¹ the filtered
-/// block-Jacobi inverse). With storeJacobi, also s = D̃⁻¹ r (the block-Jacobi preconditioner);
-/// without, s is left to the Gauss–Seidel sweeps.
-template <bool storeJacobi>
+/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs.
 Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const Vec3Array& q,
                  const std::vector<Mat3>& inverseDiagonal, Vec3Array& deltaV, Vec3Array& r,
                  Vec3Array& s) {
@@ -126,57 +123,105 @@ Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const V
   for (Index vertex = begin; vertex < end; ++vertex) {
     deltaV[vertex] += alpha * c[vertex];
     r[vertex] -= alpha * q[vertex];
-    const Vec3 jacobi = inverseDiagonal[vertex] * r[vertex];
-    if constexpr (storeJacobi) s[vertex] = jacobi;
-    sum += r[vertex].dot(jacobi);
+    s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
+    sum += r[vertex].dot(s[vertex]);
   }
   return sum;
 }
 
-/// Σ rᵀz over the range.
-Real dotRange(Index begin, Index end, const Vec3Array& r, const Vec3Array& z) {
-  Real sum = 0;
-  for (Index vertex = begin; vertex < end; ++vertex) sum += r[vertex].dot(z[vertex]);
-  return sum;
-}
+// --- Multicolour symmetric Gauss–Seidel with Eisenstat's trick (header, "Gauss–Seidel"). With
+// --- Ã = L̃ + D̃ + Ũ split by colour (L̃: blocks to earlier colours), P_L = D̃ + L̃, P_U = D̃ + Ũ = P_Lᵀ.
+// --- A sweep over one colour's vertices order[begin … end) reads only other colours' entries,
+// --- which earlier colours (forward) or later colours (backward) have finished; vertices of one
+// --- colour share no block, so a colour's vertices can run in any order or at once. S_i on every
+// --- output keeps the vectors exactly in the free subspace (exact zeros for fixed vertices).
 
-/// Forward Gauss–Seidel sweep over the vertices order[begin … end) of one colour:
-/// z_i = S_i D̃_i⁻¹ (r_i − Σ_{colour(j) < colour(i)} A_ij z_j). The z_j read belong to earlier
-/// colours, which are complete; vertices of one colour share no block, so they can run in any
-/// order or at once. S_i on the output keeps z exactly in the free subspace (exact zeros for
-/// fixed vertices, whatever their rows hold).
-void forwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
-                       const MulticolorOrdering& ordering, const VertexFilter& filter,
-                       const std::vector<Mat3>& inverseDiagonal, const Vec3Array& r, Vec3Array& z) {
-  const std::vector<Index>& order = ordering.order();
-  const std::vector<Index>& lower = ordering.lowerSlots();
-  for (Index k = begin; k < end; ++k) {
-    const Index vertex = order[k];
-    Vec3 sum = r[vertex];
-    for (Index t = ordering.lowerBegin(vertex), last = ordering.lowerBegin(vertex + 1); t < last; ++t) {
-      const Index slot = lower[t];
-      sum.noalias() -= A.block(slot) * z[A.column(slot)];
-    }
-    z[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * sum);
-  }
-}
-
-/// Backward sweep over one colour: z_i ← S_i (z_i − D̃_i⁻¹ Σ_{colour(j) > colour(i)} A_ij z_j),
-/// the later colours being final already (the sweep runs the colours in reverse).
+/// Backward sweep of one colour, t = P_U⁻¹ c: t_i = D̃_i⁻¹(c_i − Σ_{later j} A_ij t_j), and
+/// u_i = S_i Σ_{later j} A_ij t_j = c_i − D̃_i t_i, the input of the forward sweep (stored in w).
 void backwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
                         const MulticolorOrdering& ordering, const VertexFilter& filter,
-                        const std::vector<Mat3>& inverseDiagonal, Vec3Array& z) {
+                        const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c, Vec3Array& t,
+                        Vec3Array& w) {
   const std::vector<Index>& order = ordering.order();
   const std::vector<Index>& upper = ordering.upperSlots();
   for (Index k = begin; k < end; ++k) {
     const Index vertex = order[k];
     Vec3 sum = Vec3::Zero();
-    for (Index t = ordering.upperBegin(vertex), last = ordering.upperBegin(vertex + 1); t < last; ++t) {
-      const Index slot = upper[t];
-      sum.noalias() += A.block(slot) * z[A.column(slot)];
+    for (Index u = ordering.upperBegin(vertex), last = ordering.upperBegin(vertex + 1); u < last; ++u) {
+      const Index slot = upper[u];
+      sum.noalias() += A.block(slot) * t[A.column(slot)];
     }
-    z[vertex] = filter.filter(vertex, z[vertex] - inverseDiagonal[vertex] * sum);
+    t[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * (c[vertex] - sum));
+    w[vertex] = filter.filter(vertex, sum);
   }
+}
+
+/// Forward sweep of one colour, in place, w = P_L⁻¹ w: w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j).
+/// With curvature, returns Σ c_iᵀ(t_i + w_i) over the range (cᵀÂc, Â = P_L⁻¹ Ã P_U⁻¹).
+template <bool curvature>
+Real forwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
+                       const MulticolorOrdering& ordering, const VertexFilter& filter,
+                       const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c,
+                       const Vec3Array& t, Vec3Array& w) {
+  const std::vector<Index>& order = ordering.order();
+  const std::vector<Index>& lower = ordering.lowerSlots();
+  Real sum = 0;
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = order[k];
+    Vec3 rest = w[vertex];
+    for (Index l = ordering.lowerBegin(vertex), last = ordering.lowerBegin(vertex + 1); l < last; ++l) {
+      const Index slot = lower[l];
+      rest.noalias() -= A.block(slot) * w[A.column(slot)];
+    }
+    w[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * rest);
+    if constexpr (curvature) sum += c[vertex].dot(t[vertex] + w[vertex]);
+  }
+  return sum;
+}
+
+/// ŝ = D̃ r̂ over the range (the transformed system's preconditioner); returns Σ r̂ᵀŝ.
+Real diagonalRange(Index begin, Index end, const BlockSparseMatrix& A, const VertexFilter& filter,
+                   const Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    s[vertex] = filter.filter(vertex, A.block(A.diagonalSlot(vertex)) * r[vertex]);
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// Δv += α t, r̂ −= α (t + w), ŝ = D̃ r̂ over the range; returns Σ r̂ᵀŝ.
+Real transformedUpdateRange(Index begin, Index end, Real alpha, const BlockSparseMatrix& A,
+                            const VertexFilter& filter, const Vec3Array& t, const Vec3Array& w,
+                            Vec3Array& deltaV, Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    deltaV[vertex] += alpha * t[vertex];
+    r[vertex] -= alpha * (t[vertex] + w[vertex]);
+    s[vertex] = filter.filter(vertex, A.block(A.diagonalSlot(vertex)) * r[vertex]);
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// The true residual r = P_L r̂ = ŝ + S L̃ r̂ (ŝ = D̃ r̂) over a plain vertex range; returns
+/// Σ rᵀD̃⁻¹r, the stopping norm². Rows are independent: any split gives the same bits.
+Real untransformedNormRange(Index begin, Index end, const BlockSparseMatrix& A,
+                            const MulticolorOrdering& ordering, const VertexFilter& filter,
+                            const std::vector<Mat3>& inverseDiagonal, const Vec3Array& r,
+                            const Vec3Array& s) {
+  const std::vector<Index>& lower = ordering.lowerSlots();
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    Vec3 product = Vec3::Zero();
+    for (Index l = ordering.lowerBegin(vertex), last = ordering.lowerBegin(vertex + 1); l < last; ++l) {
+      const Index slot = lower[l];
+      product.noalias() += A.block(slot) * r[A.column(slot)];
+    }
+    const Vec3 residual = s[vertex] + filter.filter(vertex, product);
+    sum += residual.dot(inverseDiagonal[vertex] * residual);
+  }
+  return sum;
 }
 
 /// c = S(s + β c) over the range. s and c are in the free subspace already; filtering again
@@ -195,6 +240,7 @@ void FilteredPcg::resize(Index vertexCount) {
   m_preconditioned.assign(vertexCount, Vec3::Zero());
   m_direction.assign(vertexCount, Vec3::Zero());
   m_product.assign(vertexCount, Vec3::Zero());
+  m_backward.assign(vertexCount, Vec3::Zero());
   m_inverseDiagonal.assign(vertexCount, Mat3::Zero());
   m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
 }
@@ -245,25 +291,69 @@ void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
   }
 }
 
-Real FilteredPcg::applyGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
-                                   const Vec3Array& r, Vec3Array& z) {
-  const Index colors = m_ordering.colorCount();
-  // Each colour is cut into fixed blocks of its own vertex list; a block writes only its own
-  // vertices' z and reads other colours' z, so the bits do not depend on which thread runs it.
-  for (Index color = 0; color < colors; ++color) {
+template <typename Kernel>
+Real FilteredPcg::sumInRange(Index count, Kernel&& kernel) {
+  if (m_tasks) {
+    return m_tasks->parallelReduce(
+        count, kReductionBlock, Real(0), [&](Index begin, Index end) { return kernel(begin, end); },
+        [](Real sum, Real partial) { return sum + partial; });
+  }
+  Real sum = 0;
+  for (Index begin = 0; begin < count; begin += kReductionBlock) {
+    sum += kernel(begin, std::min(begin + kReductionBlock, count));
+  }
+  return sum;
+}
+
+template <bool curvature>
+Real FilteredPcg::forwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter,
+                               const Vec3Array& c, const Vec3Array& t, Vec3Array& w) {
+  // Colour by colour; a colour's partial sums in block order, the colours' sums in colour order:
+  // one summation order whatever the thread count.
+  Real sum = 0;
+  for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
-    forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      forwardSweepRange(first + begin, first + end, A, m_ordering, filter, m_inverseDiagonal, r, z);
+    sum += sumInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+      return forwardSweepRange<curvature>(first + begin, first + end, A, m_ordering, filter,
+                                          m_inverseDiagonal, c, t, w);
     });
   }
-  for (Index color = colors; color-- > 0;) {
+  return sum;
+}
+
+void FilteredPcg::backwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                const Vec3Array& c, Vec3Array& t, Vec3Array& w) {
+  for (Index color = m_ordering.colorCount(); color-- > 0;) {
     const Index first = m_ordering.colorBegin(color);
     forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      backwardSweepRange(first + begin, first + end, A, m_ordering, filter, m_inverseDiagonal, z);
+      backwardSweepRange(first + begin, first + end, A, m_ordering, filter, m_inverseDiagonal, c,
+                         t, w);
     });
   }
-  return sumOverBlocks(A.blockRows(),
-                       [&](Index begin, Index end) { return dotRange(begin, end, r, z); });
+}
+
+void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                      PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
+                                      TaskSystem* tasks) {
+  m_tasks = tasks;
+  const Index vertexCount = A.blockRows();
+  if (m_residual.size() != vertexCount) resize(vertexCount);
+  z.resize(vertexCount);
+  forEachBlock(vertexCount, [&](Index begin, Index end) {
+    buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
+  });
+  if (kind != PreconditionerKind::MulticolorGaussSeidel) {
+    for (Index vertex = 0; vertex < vertexCount; ++vertex) z[vertex] = m_inverseDiagonal[vertex] * r[vertex];
+    return;
+  }
+  if (!m_ordering.matches(A)) m_ordering.build(A);
+  Vec3Array& w = m_product;
+  std::copy(r.begin(), r.end(), w.begin());
+  forwardSweep<false>(A, filter, m_direction, m_backward, w);  // w = P_L⁻¹ r
+  sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return diagonalRange(begin, end, A, filter, w, m_preconditioned);  // D̃ w
+  });
+  backwardSweep(A, filter, m_preconditioned, z, m_residual);  // z = P_U⁻¹ D̃ w
 }
 
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
@@ -288,7 +378,6 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   Vec3Array& r = m_residual;
   Vec3Array& s = m_preconditioned;
   Vec3Array& c = m_direction;
-  Vec3Array& q = m_product;
 
   forEachBlock(vertexCount, [&](Index begin, Index end) {
     buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
@@ -324,36 +413,53 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
     return residualRange(begin, end, A, b, filter, m_inverseDiagonal, deltaV, r, s);
   });
   if (!warmStart) referenceDelta = stopDelta;
-  Real delta = gaussSeidel ? applyGaussSeidel(A, filter, r, s) : stopDelta;
 
   // rᵀP̃⁻¹r ≥ 0 in exact arithmetic; clamp rounding below zero before the square root.
   const Real referenceNorm = std::sqrt(std::max(referenceDelta, Real(0)));
-  const Real threshold = std::max(settings.tolerance * referenceNorm, settings.absoluteTolerance);
-  const Real denominator = std::max(referenceNorm, settings.absoluteTolerance);
-  const bool referenceFinite = std::isfinite(referenceDelta);
+  const Stopping stopping{std::max(settings.tolerance * referenceNorm, settings.absoluteTolerance),
+                          std::max(referenceNorm, settings.absoluteTolerance),
+                          std::isfinite(referenceDelta), settings.maxIterations};
+  if (gaussSeidel) {
+    iterateGaussSeidel(A, filter, stopping, stopDelta, deltaV, report);
+  } else {
+    iterateJacobi(A, filter, stopping, stopDelta, deltaV, report);
+  }
+  return report;
+}
 
+/// Fills the report's residual fields from the stopping norm² and says whether it converged.
+bool FilteredPcg::Stopping::judge(Real stopDelta, SolveReport& report) const {
+  // NaN compares false with everything, so test finiteness first: a NaN residual must end the
+  // loop as a failure, never look converged and never spin until the cap.
+  if (!referenceFinite || !std::isfinite(stopDelta)) {
+    report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
+    report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
+    report.converged = false;
+    return false;
+  }
+  report.residualNorm = std::sqrt(std::max(stopDelta, Real(0)));
+  // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
+  report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
+                            : report.residualNorm == 0 ? Real(0)
+                                                       : std::numeric_limits<Real>::infinity();
+  report.converged = report.residualNorm <= threshold;
+  return report.converged;
+}
+
+void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                const Stopping& stopping, Real delta, Vec3Array& deltaV,
+                                SolveReport& report) {
+  const Index vertexCount = A.blockRows();
+  Vec3Array& r = m_residual;
+  Vec3Array& s = m_preconditioned;
+  Vec3Array& c = m_direction;
+  Vec3Array& q = m_product;
   forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
 
   Real previousDelta = delta;
   for (;;) {
-    // NaN compares false with everything, so test finiteness first: a NaN residual must end the
-    // loop as a failure, never look converged and never spin until the cap.
-    if (!referenceFinite || !std::isfinite(delta) || !std::isfinite(stopDelta)) {
-      report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
-      report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
-      report.converged = false;
-      break;
-    }
-    report.residualNorm = std::sqrt(std::max(stopDelta, Real(0)));
-    // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
-    report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
-                              : report.residualNorm == 0 ? Real(0)
-                                                         : std::numeric_limits<Real>::infinity();
-    if (report.residualNorm <= threshold) {
-      report.converged = true;
-      break;
-    }
-    if (report.iterations >= settings.maxIterations) break;
+    if (stopping.judge(delta, report) || !std::isfinite(report.residualNorm)) break;
+    if (report.iterations >= stopping.maxIterations) break;
 
     if (report.iterations > 0) {
       const Real beta = delta / previousDelta;
@@ -375,20 +481,78 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
     }
     const Real alpha = delta / curvature;
     previousDelta = delta;
-    if (gaussSeidel) {
-      stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-        return updateRange<false>(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
-      });
-      delta = applyGaussSeidel(A, filter, r, s);
-    } else {
-      stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-        return updateRange<true>(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
-      });
-      delta = stopDelta;
-    }
+    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
+    });
     ++report.iterations;
   }
-  return report;
+}
+
+void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                     const Stopping& stopping, Real startStopDelta,
+                                     Vec3Array& deltaV, SolveReport& report) {
+  const Index vertexCount = A.blockRows();
+  Vec3Array& r = m_residual;        // r̂ = P_L⁻¹ r
+  Vec3Array& s = m_preconditioned;  // ŝ = D̃ r̂
+  Vec3Array& c = m_direction;       // ĉ
+  Vec3Array& t = m_backward;        // t = P_U⁻¹ ĉ, the search direction in Δv's space
+  Vec3Array& w = m_product;         // u, then w = P_L⁻¹ u; Â ĉ = t + w
+
+  // The start's residual is exact (residualRange); a bad one ends the solve before any sweep.
+  if (stopping.judge(startStopDelta, report) || !std::isfinite(report.residualNorm)) return;
+  if (stopping.maxIterations <= 0) return;
+
+  forwardSweep<false>(A, filter, c, t, r);  // r̂ = P_L⁻¹ r, in place
+  Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return diagonalRange(begin, end, A, filter, r, s);
+  });
+  forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
+  // ‖r‖²_{M⁻¹} = r̂ᵀD̃r̂ = delta (M the SGS preconditioner) falls with CG's iterations; its ratio to
+  // the start scales the start's exact ‖r‖_{D̃⁻¹} into an estimate, and the exact norm (one
+  // half-SpMV) is computed only once the estimate is below the threshold.
+  const Real startDelta = delta;
+  const Real startNorm = report.residualNorm;
+  auto exactStopDelta = [&] {
+    return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return untransformedNormRange(begin, end, A, m_ordering, filter, m_inverseDiagonal, r, s);
+    });
+  };
+
+  Real previousDelta = delta;
+  for (;;) {
+    if (!std::isfinite(delta)) {
+      stopping.judge(std::numeric_limits<Real>::quiet_NaN(), report);
+      break;
+    }
+    if (report.iterations > 0) {
+      const Real estimate =
+          startDelta > 0 ? startNorm * std::sqrt(std::max(delta, Real(0)) / startDelta) : Real(0);
+      if (estimate <= stopping.threshold || report.iterations >= stopping.maxIterations) {
+        if (stopping.judge(exactStopDelta(), report) || !std::isfinite(report.residualNorm)) break;
+      }
+      if (report.iterations >= stopping.maxIterations) break;
+      const Real beta = delta / previousDelta;
+      forEachBlock(vertexCount, [&](Index begin, Index end) {
+        directionRange(begin, end, beta, filter, s, c);
+      });
+    }
+    backwardSweep(A, filter, c, t, w);
+    const Real curvature = forwardSweep<true>(A, filter, c, t, w);
+    // ĉᵀÂĉ ≤ 0: breakdown (A not positive definite on the free subspace, or a NaN). Δv keeps the
+    // last finite iterate; the report gets that iterate's exact residual.
+    if (!(curvature > 0) || !std::isfinite(curvature)) {
+      if (!std::isfinite(curvature)) stopping.judge(std::numeric_limits<Real>::quiet_NaN(), report);
+      else if (report.iterations > 0) stopping.judge(exactStopDelta(), report);
+      report.converged = false;
+      break;
+    }
+    const Real alpha = delta / curvature;
+    previousDelta = delta;
+    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return transformedUpdateRange(begin, end, alpha, A, filter, t, w, deltaV, r, s);
+    });
+    ++report.iterations;
+  }
 }
 
 }  // namespace weft

@@ -105,6 +105,13 @@ class FilteredPcg {
   SolveReport solve(const BlockSparseMatrix& A, const Vec3Array& b, const VertexFilter& filter,
                     const PcgSettings& settings, Vec3Array& deltaV, TaskSystem* tasks = nullptr);
 
+  /// z = P̃⁻¹ r: the preconditioner `kind` built from A and filter exactly as solve() builds it
+  /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r). r should lie in the free subspace
+  /// (S r = r); z does, exactly zero at fixed vertices. For tests and diagnostics; sizes as solve().
+  void applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
+                           PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
+                           TaskSystem* tasks = nullptr);
+
  private:
   /// Runs kernel(begin, end) over the reduction blocks in order and returns the sum of the
   /// returned partials, combined in block order (the deterministic reduction).
@@ -119,15 +126,43 @@ class FilteredPcg {
   template <typename Kernel>
   void forEachInRange(Index count, Kernel&& kernel);
 
-  /// z = P⁻¹ r for the multicolour symmetric Gauss–Seidel preconditioner (forward sweep over the
-  /// colours, then backward); returns rᵀz, summed in fixed vertex blocks.
-  Real applyGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter, const Vec3Array& r,
-                        Vec3Array& z);
+  /// Sums kernel(begin, end) over fixed blocks of [0, count), in block order.
+  template <typename Kernel>
+  Real sumInRange(Index count, Kernel&& kernel);
+
+  /// w = P_L⁻¹ w in place, colour by colour; with curvature, returns Σ cᵀ(t + w).
+  template <bool curvature>
+  Real forwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter, const Vec3Array& c,
+                    const Vec3Array& t, Vec3Array& w);
+
+  /// t = P_U⁻¹ c and w = c − D̃ t, colours in reverse.
+  void backwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter, const Vec3Array& c,
+                     Vec3Array& t, Vec3Array& w);
+
+  /// The stopping rule of one solve (header, "Stopping").
+  struct Stopping {
+    Real threshold;       ///< √kg·m/s, stop when ‖r‖_{D̃⁻¹} ≤ threshold
+    Real denominator;     ///< √kg·m/s, of relativeResidual
+    bool referenceFinite; ///< the reference residual was finite
+    int maxIterations;    ///< iteration cap
+    /// Sets report's residual fields from ‖r‖²_{D̃⁻¹}; true when converged.
+    bool judge(Real stopDelta, SolveReport& report) const;
+  };
+
+  /// CG iterations with the block-Jacobi preconditioner from the start residual in r, s.
+  void iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& filter, const Stopping& stopping,
+                     Real delta, Vec3Array& deltaV, SolveReport& report);
+
+  /// CG iterations with multicolour symmetric Gauss–Seidel (Eisenstat form) from r.
+  void iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
+                          const Stopping& stopping, Real startStopDelta, Vec3Array& deltaV,
+                          SolveReport& report);
 
   Vec3Array m_residual;          ///< r = S(b − AΔv)
   Vec3Array m_preconditioned;    ///< s = P̃⁻¹ r
   Vec3Array m_direction;         ///< c, the filtered search direction
-  Vec3Array m_product;           ///< q = S A c
+  Vec3Array m_product;           ///< q = S A c (Gauss–Seidel: u, then w = P_L⁻¹ u)
+  Vec3Array m_backward;          ///< t = P_U⁻¹ ĉ (Gauss–Seidel only)
   std::vector<Mat3> m_inverseDiagonal;  ///< P̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
   MulticolorOrdering m_ordering;        ///< colouring of A's pattern (Gauss–Seidel only)
