@@ -117,21 +117,31 @@ TEST(MulticolorOrdering, ColoursSeparateCoupledVerticesAndSplitEveryOffDiagonalS
   }
   for (Index v = 0; v < 500; ++v) ASSERT_EQ(seen[v], 1) << "vertex " << v;
 
-  for (Index row = 0; row < A.blockRows(); ++row) {
+  // Sweep position k is vertex order()[k]; its lower and upper entries split its row.
+  for (Index k = 0; k < A.blockRows(); ++k) {
+    const Index row = ordering.order()[k];
     Index offDiagonal = 0;
     for (Index s = A.rowBegin(row); s < A.rowEnd(row); ++s) {
       if (A.column(s) == row) continue;
       ++offDiagonal;
       ASSERT_NE(ordering.color(A.column(s)), ordering.color(row)) << "coupled pair shares a colour";
     }
-    const Index lowerCount = ordering.lowerBegin(row + 1) - ordering.lowerBegin(row);
-    const Index upperCount = ordering.upperBegin(row + 1) - ordering.upperBegin(row);
+    const Index lowerCount = ordering.lowerBegin(k + 1) - ordering.lowerBegin(k);
+    const Index upperCount = ordering.upperBegin(k + 1) - ordering.upperBegin(k);
     EXPECT_EQ(lowerCount + upperCount, offDiagonal) << "row " << row;
-    for (Index k = ordering.lowerBegin(row); k < ordering.lowerBegin(row + 1); ++k) {
-      EXPECT_LT(ordering.color(A.column(ordering.lowerSlots()[k])), ordering.color(row));
+    for (Index e = ordering.lowerBegin(k); e < ordering.lowerBegin(k + 1); ++e) {
+      const Index slot = ordering.lowerSlots()[e];
+      EXPECT_EQ(A.column(slot), ordering.lowerColumns()[e]);
+      EXPECT_GE(slot, A.rowBegin(row));
+      EXPECT_LT(slot, A.rowEnd(row));
+      EXPECT_LT(ordering.color(A.column(slot)), ordering.color(row));
     }
-    for (Index k = ordering.upperBegin(row); k < ordering.upperBegin(row + 1); ++k) {
-      EXPECT_GT(ordering.color(A.column(ordering.upperSlots()[k])), ordering.color(row));
+    for (Index e = ordering.upperBegin(k); e < ordering.upperBegin(k + 1); ++e) {
+      const Index slot = ordering.upperSlots()[e];
+      EXPECT_EQ(A.column(slot), ordering.upperColumns()[e]);
+      EXPECT_GE(slot, A.rowBegin(row));
+      EXPECT_LT(slot, A.rowEnd(row));
+      EXPECT_GT(ordering.color(A.column(slot)), ordering.color(row));
     }
   }
 

@@ -136,42 +136,61 @@ Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const V
 // --- colour share no block, so a colour's vertices can run in any order or at once. S_i on every
 // --- output keeps the vectors exactly in the free subspace (exact zeros for fixed vertices).
 
-/// Backward sweep of one colour, t = P_U⁻¹ c: t_i = D̃_i⁻¹(c_i − Σ_{later j} A_ij t_j), and
-/// u_i = S_i Σ_{later j} A_ij t_j = c_i − D̃_i t_i, the input of the forward sweep (stored in w).
-void backwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
+/// The off-diagonal blocks of A in the ordering's sweep order (lower and upper entries), copied
+/// once per solve so the sweeps read them front to back.
+struct PackedBlocks {
+  const std::vector<Mat3>& lower;
+  const std::vector<Mat3>& upper;
+};
+
+/// Copies the blocks of the entries of sweep positions [begin, end) into packed order.
+void packRange(Index begin, Index end, const BlockSparseMatrix& A,
+               const MulticolorOrdering& ordering, std::vector<Mat3>& lower,
+               std::vector<Mat3>& upper) {
+  for (Index e = ordering.lowerBegin(begin), last = ordering.lowerBegin(end); e < last; ++e) {
+    lower[e] = A.block(ordering.lowerSlots()[e]);
+  }
+  for (Index e = ordering.upperBegin(begin), last = ordering.upperBegin(end); e < last; ++e) {
+    upper[e] = A.block(ordering.upperSlots()[e]);
+  }
+}
+
+/// Backward sweep over sweep positions [begin, end) of one colour, t = P_U⁻¹ c:
+/// t_i = D̃_i⁻¹(c_i − Σ_{later j} A_ij t_j), and u_i = S_i Σ_{later j} A_ij t_j = c_i − D̃_i t_i, the
+/// input of the forward sweep (stored in w).
+void backwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
                         const MulticolorOrdering& ordering, const VertexFilter& filter,
                         const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c, Vec3Array& t,
                         Vec3Array& w) {
-  const std::vector<Index>& order = ordering.order();
-  const std::vector<Index>& upper = ordering.upperSlots();
+  const Index* columns = ordering.upperColumns().data();
+  const Mat3* upper = blocks.upper.data();
   for (Index k = begin; k < end; ++k) {
-    const Index vertex = order[k];
+    const Index vertex = ordering.order()[k];
     Vec3 sum = Vec3::Zero();
-    for (Index u = ordering.upperBegin(vertex), last = ordering.upperBegin(vertex + 1); u < last; ++u) {
-      const Index slot = upper[u];
-      sum.noalias() += A.block(slot) * t[A.column(slot)];
+    for (Index e = ordering.upperBegin(k), last = ordering.upperBegin(k + 1); e < last; ++e) {
+      sum.noalias() += upper[e] * t[columns[e]];
     }
     t[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * (c[vertex] - sum));
     w[vertex] = filter.filter(vertex, sum);
   }
 }
 
-/// Forward sweep of one colour, in place, w = P_L⁻¹ w: w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j).
-/// With curvature, returns Σ c_iᵀ(t_i + w_i) over the range (cᵀÂc, Â = P_L⁻¹ Ã P_U⁻¹).
+/// Forward sweep over sweep positions [begin, end) of one colour, in place, w = P_L⁻¹ w:
+/// w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j). With curvature, returns Σ c_iᵀ(t_i + w_i) over the
+/// range (ĉᵀÂĉ, Â = P_L⁻¹ Ã P_U⁻¹).
 template <bool curvature>
-Real forwardSweepRange(Index begin, Index end, const BlockSparseMatrix& A,
+Real forwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
                        const MulticolorOrdering& ordering, const VertexFilter& filter,
                        const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c,
                        const Vec3Array& t, Vec3Array& w) {
-  const std::vector<Index>& order = ordering.order();
-  const std::vector<Index>& lower = ordering.lowerSlots();
+  const Index* columns = ordering.lowerColumns().data();
+  const Mat3* lower = blocks.lower.data();
   Real sum = 0;
   for (Index k = begin; k < end; ++k) {
-    const Index vertex = order[k];
+    const Index vertex = ordering.order()[k];
     Vec3 rest = w[vertex];
-    for (Index l = ordering.lowerBegin(vertex), last = ordering.lowerBegin(vertex + 1); l < last; ++l) {
-      const Index slot = lower[l];
-      rest.noalias() -= A.block(slot) * w[A.column(slot)];
+    for (Index e = ordering.lowerBegin(k), last = ordering.lowerBegin(k + 1); e < last; ++e) {
+      rest.noalias() -= lower[e] * w[columns[e]];
     }
     w[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * rest);
     if constexpr (curvature) sum += c[vertex].dot(t[vertex] + w[vertex]);
@@ -204,19 +223,20 @@ Real transformedUpdateRange(Index begin, Index end, Real alpha, const BlockSpars
   return sum;
 }
 
-/// The true residual r = P_L r̂ = ŝ + S L̃ r̂ (ŝ = D̃ r̂) over a plain vertex range; returns
-/// Σ rᵀD̃⁻¹r, the stopping norm². Rows are independent: any split gives the same bits.
-Real untransformedNormRange(Index begin, Index end, const BlockSparseMatrix& A,
+/// The true residual r = P_L r̂ = ŝ + S L̃ r̂ (ŝ = D̃ r̂) over sweep positions [begin, end); returns
+/// Σ rᵀD̃⁻¹r, the stopping norm². Positions are independent: any split gives the same bits.
+Real untransformedNormRange(Index begin, Index end, const PackedBlocks& blocks,
                             const MulticolorOrdering& ordering, const VertexFilter& filter,
                             const std::vector<Mat3>& inverseDiagonal, const Vec3Array& r,
                             const Vec3Array& s) {
-  const std::vector<Index>& lower = ordering.lowerSlots();
+  const Index* columns = ordering.lowerColumns().data();
+  const Mat3* lower = blocks.lower.data();
   Real sum = 0;
-  for (Index vertex = begin; vertex < end; ++vertex) {
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = ordering.order()[k];
     Vec3 product = Vec3::Zero();
-    for (Index l = ordering.lowerBegin(vertex), last = ordering.lowerBegin(vertex + 1); l < last; ++l) {
-      const Index slot = lower[l];
-      product.noalias() += A.block(slot) * r[A.column(slot)];
+    for (Index e = ordering.lowerBegin(k), last = ordering.lowerBegin(k + 1); e < last; ++e) {
+      product.noalias() += lower[e] * r[columns[e]];
     }
     const Vec3 residual = s[vertex] + filter.filter(vertex, product);
     sum += residual.dot(inverseDiagonal[vertex] * residual);
@@ -305,8 +325,20 @@ Real FilteredPcg::sumInRange(Index count, Kernel&& kernel) {
   return sum;
 }
 
+void FilteredPcg::prepareGaussSeidel(const BlockSparseMatrix& A) {
+  if (!m_ordering.matches(A)) {
+    // A new pattern (set-up, or a topology change): colour it, size the packed blocks. Allocates.
+    m_ordering.build(A);
+    m_lowerBlocks.resize(m_ordering.lowerSlots().size());
+    m_upperBlocks.resize(m_ordering.upperSlots().size());
+  }
+  forEachBlock(A.blockRows(), [&](Index begin, Index end) {
+    packRange(begin, end, A, m_ordering, m_lowerBlocks, m_upperBlocks);
+  });
+}
+
 template <bool curvature>
-Real FilteredPcg::forwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter,
+Real FilteredPcg::forwardSweep(const VertexFilter& filter,
                                const Vec3Array& c, const Vec3Array& t, Vec3Array& w) {
   // Colour by colour; a colour's partial sums in block order, the colours' sums in colour order:
   // one summation order whatever the thread count.
@@ -314,20 +346,20 @@ Real FilteredPcg::forwardSweep(const BlockSparseMatrix& A, const VertexFilter& f
   for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
     sum += sumInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      return forwardSweepRange<curvature>(first + begin, first + end, A, m_ordering, filter,
-                                          m_inverseDiagonal, c, t, w);
+      return forwardSweepRange<curvature>(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering,
+                                          filter, m_inverseDiagonal, c, t, w);
     });
   }
   return sum;
 }
 
-void FilteredPcg::backwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter,
+void FilteredPcg::backwardSweep(const VertexFilter& filter,
                                 const Vec3Array& c, Vec3Array& t, Vec3Array& w) {
   for (Index color = m_ordering.colorCount(); color-- > 0;) {
     const Index first = m_ordering.colorBegin(color);
     forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      backwardSweepRange(first + begin, first + end, A, m_ordering, filter, m_inverseDiagonal, c,
-                         t, w);
+      backwardSweepRange(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
+                         m_inverseDiagonal, c, t, w);
     });
   }
 }
@@ -346,14 +378,14 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
     for (Index vertex = 0; vertex < vertexCount; ++vertex) z[vertex] = m_inverseDiagonal[vertex] * r[vertex];
     return;
   }
-  if (!m_ordering.matches(A)) m_ordering.build(A);
+  prepareGaussSeidel(A);
   Vec3Array& w = m_product;
   std::copy(r.begin(), r.end(), w.begin());
-  forwardSweep<false>(A, filter, m_direction, m_backward, w);  // w = P_L⁻¹ r
+  forwardSweep<false>(filter, m_direction, m_backward, w);  // w = P_L⁻¹ r
   sumOverBlocks(vertexCount, [&](Index begin, Index end) {
     return diagonalRange(begin, end, A, filter, w, m_preconditioned);  // D̃ w
   });
-  backwardSweep(A, filter, m_preconditioned, z, m_residual);  // z = P_U⁻¹ D̃ w
+  backwardSweep(filter, m_preconditioned, z, m_residual);  // z = P_U⁻¹ D̃ w
 }
 
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
@@ -384,7 +416,7 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   });
   const bool gaussSeidel = settings.preconditioner == PreconditionerKind::MulticolorGaussSeidel;
   // The colouring depends on the pattern only: rebuilt (allocating) when the topology changes.
-  if (gaussSeidel && !m_ordering.matches(A)) m_ordering.build(A);
+  if (gaussSeidel) prepareGaussSeidel(A);
 
   // The reference r_ref = S(b − A(I − S)z). A cold start begins exactly there, so it is the initial
   // residual; a warm start needs it separately, and needs the SpMV only when some target is nonzero.
@@ -502,7 +534,7 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   if (stopping.judge(startStopDelta, report) || !std::isfinite(report.residualNorm)) return;
   if (stopping.maxIterations <= 0) return;
 
-  forwardSweep<false>(A, filter, c, t, r);  // r̂ = P_L⁻¹ r, in place
+  forwardSweep<false>(filter, c, t, r);  // r̂ = P_L⁻¹ r, in place
   Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
     return diagonalRange(begin, end, A, filter, r, s);
   });
@@ -514,7 +546,8 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   const Real startNorm = report.residualNorm;
   auto exactStopDelta = [&] {
     return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return untransformedNormRange(begin, end, A, m_ordering, filter, m_inverseDiagonal, r, s);
+      return untransformedNormRange(begin, end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
+                                    m_inverseDiagonal, r, s);
     });
   };
 
@@ -536,8 +569,8 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
         directionRange(begin, end, beta, filter, s, c);
       });
     }
-    backwardSweep(A, filter, c, t, w);
-    const Real curvature = forwardSweep<true>(A, filter, c, t, w);
+    backwardSweep(filter, c, t, w);
+    const Real curvature = forwardSweep<true>(filter, c, t, w);
     // ĉᵀÂĉ ≤ 0: breakdown (A not positive definite on the free subspace, or a NaN). Δv keeps the
     // last finite iterate; the report gets that iterate's exact residual.
     if (!(curvature > 0) || !std::isfinite(curvature)) {

@@ -132,12 +132,15 @@ class FilteredPcg {
 
   /// w = P_L⁻¹ w in place, colour by colour; with curvature, returns Σ cᵀ(t + w).
   template <bool curvature>
-  Real forwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter, const Vec3Array& c,
-                    const Vec3Array& t, Vec3Array& w);
+  Real forwardSweep(const VertexFilter& filter, const Vec3Array& c, const Vec3Array& t,
+                    Vec3Array& w);
 
   /// t = P_U⁻¹ c and w = c − D̃ t, colours in reverse.
-  void backwardSweep(const BlockSparseMatrix& A, const VertexFilter& filter, const Vec3Array& c,
-                     Vec3Array& t, Vec3Array& w);
+  void backwardSweep(const VertexFilter& filter, const Vec3Array& c, Vec3Array& t, Vec3Array& w);
+
+  /// Colours A's pattern if it is new (allocates then) and packs its off-diagonal blocks in sweep
+  /// order (every solve: the values change).
+  void prepareGaussSeidel(const BlockSparseMatrix& A);
 
   /// The stopping rule of one solve (header, "Stopping").
   struct Stopping {
@@ -166,6 +169,8 @@ class FilteredPcg {
   std::vector<Mat3> m_inverseDiagonal;  ///< P̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
   MulticolorOrdering m_ordering;        ///< colouring of A's pattern (Gauss–Seidel only)
+  std::vector<Mat3> m_lowerBlocks;      ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
+  std::vector<Mat3> m_upperBlocks;      ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
 };
 

@@ -34,23 +34,25 @@ void MulticolorOrdering::build(const BlockSparseMatrix& matrix) {
   std::vector<Index> fill(m_colorOffsets.begin(), m_colorOffsets.end() - 1);
   for (Index vertex = 0; vertex < rows; ++vertex) m_order[fill[m_colors[vertex]]++] = vertex;
 
-  // Per-row split of the off-diagonal slots. Neighbours never share a colour (that is what the
-  // colouring guarantees), so every off-diagonal slot lands in exactly one of the two lists.
+  // Split of the off-diagonal slots, in sweep order. Neighbours never share a colour (that is
+  // what the colouring guarantees), so every off-diagonal slot lands in exactly one of the lists.
   m_lowerOffsets.assign(static_cast<size_t>(rows) + 1, 0);
   m_upperOffsets.assign(static_cast<size_t>(rows) + 1, 0);
-  m_lowerSlots.clear();
-  m_upperSlots.clear();
-  m_lowerSlots.reserve(matrix.blockCount() / 2);
-  m_upperSlots.reserve(matrix.blockCount() / 2);
-  for (Index vertex = 0; vertex < rows; ++vertex) {
+  for (std::vector<Index>* list : {&m_lowerSlots, &m_lowerColumns, &m_upperSlots, &m_upperColumns}) {
+    list->clear();
+    list->reserve(matrix.blockCount() / 2);
+  }
+  for (Index position = 0; position < rows; ++position) {
+    const Index vertex = m_order[position];
     for (Index s = matrix.rowBegin(vertex); s < matrix.rowEnd(vertex); ++s) {
       const Index neighbour = matrix.column(s);
       if (neighbour == vertex) continue;
-      if (m_colors[neighbour] < m_colors[vertex]) m_lowerSlots.push_back(s);
-      else m_upperSlots.push_back(s);
+      const bool lower = m_colors[neighbour] < m_colors[vertex];
+      (lower ? m_lowerSlots : m_upperSlots).push_back(s);
+      (lower ? m_lowerColumns : m_upperColumns).push_back(neighbour);
     }
-    m_lowerOffsets[vertex + 1] = static_cast<Index>(m_lowerSlots.size());
-    m_upperOffsets[vertex + 1] = static_cast<Index>(m_upperSlots.size());
+    m_lowerOffsets[position + 1] = static_cast<Index>(m_lowerSlots.size());
+    m_upperOffsets[position + 1] = static_cast<Index>(m_upperSlots.size());
   }
   m_patternId = matrix.patternId();
 }

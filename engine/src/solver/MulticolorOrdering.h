@@ -17,8 +17,9 @@
 // - What is stored. The vertices of each colour, ascending, one colour after another (`order`,
 //   `colorOffsets`), and for every row the slots of its blocks split by colour: `lower` slots
 //   (column of a smaller colour: the "L" part the forward sweep reads) and `upper` slots (larger
-//   colour: the "U" part of the backward sweep). The diagonal is in neither. Slots index the
-//   matrix's block array directly, so the sweeps read blocks in place with no copy.
+//   colour: the "U" part of the backward sweep), listed in sweep order with their columns. The
+//   diagonal is in neither. FilteredPcg copies the blocks of these slots once per solve into
+//   arrays in the same order, so every sweep streams through memory front to back.
 // - The ordering depends on the pattern only, not on the values: build it once per topology
 //   (BlockSparseMatrix::patternId() tells when the pattern changed) and reuse it every step.
 //   Nothing here depends on how the system is indexed or which vertices it contains.
@@ -57,23 +58,32 @@ class MulticolorOrdering {
   Index colorBegin(Index color) const { return m_colorOffsets[color]; }
   Index colorEnd(Index color) const { return m_colorOffsets[color + 1]; }
 
-  /// Slots of row `vertex` whose column has a smaller colour: lowerSlots()[lowerBegin(v) … lowerBegin(v + 1)).
-  Index lowerBegin(Index vertex) const { return m_lowerOffsets[vertex]; }
-  const std::vector<Index>& lowerSlots() const { return m_lowerSlots; }
+  // The off-diagonal entries, in sweep order: position k = 0 … blockRows − 1 is vertex order()[k];
+  // its lower entries are [lowerBegin(k), lowerBegin(k + 1)), its upper ones likewise. Entry e
+  // names the matrix slot (lowerSlots()[e]) and the column vertex (lowerColumns()[e]), so a sweep
+  // reads both arrays front to back.
 
-  /// Slots of row `vertex` whose column has a larger colour: upperSlots()[upperBegin(v) … upperBegin(v + 1)).
-  Index upperBegin(Index vertex) const { return m_upperOffsets[vertex]; }
+  /// First lower entry (column of a smaller colour) of sweep position k.
+  Index lowerBegin(Index position) const { return m_lowerOffsets[position]; }
+  const std::vector<Index>& lowerSlots() const { return m_lowerSlots; }
+  const std::vector<Index>& lowerColumns() const { return m_lowerColumns; }
+
+  /// First upper entry (column of a larger colour) of sweep position k.
+  Index upperBegin(Index position) const { return m_upperOffsets[position]; }
   const std::vector<Index>& upperSlots() const { return m_upperSlots; }
+  const std::vector<Index>& upperColumns() const { return m_upperColumns; }
 
  private:
   std::uint64_t m_patternId = 0;     ///< pattern this was built from; 0 = never built
   std::vector<Index> m_colors;        ///< colour per vertex
   std::vector<Index> m_order;         ///< vertices sorted by (colour, index)
   std::vector<Index> m_colorOffsets;  ///< colorCount + 1 entries into m_order
-  std::vector<Index> m_lowerOffsets;  ///< blockRows + 1 entries into m_lowerSlots
-  std::vector<Index> m_lowerSlots;    ///< slots with a smaller-colour column, per row
-  std::vector<Index> m_upperOffsets;  ///< blockRows + 1 entries into m_upperSlots
-  std::vector<Index> m_upperSlots;    ///< slots with a larger-colour column, per row
+  std::vector<Index> m_lowerOffsets;  ///< blockRows + 1 entries (per sweep position) into m_lower*
+  std::vector<Index> m_lowerSlots;    ///< slots with a smaller-colour column, in sweep order
+  std::vector<Index> m_lowerColumns;  ///< their columns
+  std::vector<Index> m_upperOffsets;  ///< blockRows + 1 entries (per sweep position) into m_upper*
+  std::vector<Index> m_upperSlots;    ///< slots with a larger-colour column, in sweep order
+  std::vector<Index> m_upperColumns;  ///< their columns
 };
 
 }  // namespace weft
