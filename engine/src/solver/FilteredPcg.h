@@ -18,7 +18,7 @@
 //   on both sides: D̃_i⁻¹ = S_i (S_i A_ii S_i + I − S_i)⁻¹ S_i, the exact inverse of A_ii on the
 //   vertex's free subspace and zero on the constrained one (zero for fixed vertices). Filtering
 //   keeps s = D̃⁻¹r in the free subspace, so the residual norm below sees free directions only.
-// - Gauss–Seidel (PreconditionerKind::MulticolorGaussSeidel, the default). Block Jacobi ignores
+// - Gauss–Seidel (PreconditionerKind::MulticolorGaussSeidel, opt-in; SolverSettings says why). Block Jacobi ignores
 //   the coupling between vertices, which dominates the mass on stiff cloth (iterations grow with
 //   stiffness until the cap). Symmetric Gauss–Seidel (SSOR, ω = 1) on the filtered matrix
 //   Ã = S A S + (I − S) keeps it: with Ã = L̃ + D̃ + L̃ᵀ, M = (D̃ + L̃) D̃⁻¹ (D̃ + L̃)ᵀ, SPD, and on the
@@ -91,7 +91,7 @@ struct PcgSettings {
   Real absoluteTolerance = 1e-12;
   /// Which preconditioner (SolverSettings::preconditioner). The stopping norm is the block-Jacobi
   /// one for every kind, so the tolerance means the same accuracy whichever is used.
-  PreconditionerKind preconditioner = PreconditionerKind::MulticolorGaussSeidel;
+  PreconditionerKind preconditioner = PreconditionerKind::BlockJacobi;
 };
 
 /// What one FilteredPcg::solve did.
