@@ -140,8 +140,9 @@ Eigen::VectorXd reducedSolution(const BlockSparseMatrix& A, const Vec3Array& b,
   return flatten(t) + q * ldlt.solve(rhs);
 }
 
-PcgSettings tightSettings() {
+PcgSettings tightSettings(PreconditionerKind kind) {
   PcgSettings settings;
+  settings.preconditioner = kind;
   settings.tolerance = 1e-10;
   settings.maxIterations = 2000;
   settings.warmStart = false;
@@ -205,15 +206,26 @@ TEST(VertexFilter, ParallelSecondDirectionFallsBackToOneDirection) {
 }
 
 // ----------------------------------------------------------------------------- FilteredPcg
+// Every contract test runs with both preconditioners (PreconditionerTest tests the Gauss–Seidel
+// one alone). The stopping norm is the block-Jacobi one for both, so the checks are the same.
 
-TEST(FilteredPcg, ReachesTheToleranceOnTheTrueResidual) {
+/// Default settings with the preconditioner under test.
+PcgSettings settingsFor(PreconditionerKind kind) {
+  PcgSettings settings;
+  settings.preconditioner = kind;
+  return settings;
+}
+
+class FilteredPcgTest : public ::testing::TestWithParam<PreconditionerKind> {};
+
+TEST_P(FilteredPcgTest, ReachesTheToleranceOnTheTrueResidual) {
   const RandomSystem system = makeRandomSystem(700, 1);
   VertexFilter filter;
   filter.resize(700);
   FilteredPcg pcg;
   pcg.resize(700);
   for (Real tolerance : {1e-3, 1e-6}) {
-    PcgSettings settings;
+    PcgSettings settings = settingsFor(GetParam());
     settings.tolerance = tolerance;
     settings.maxIterations = 1000;
     settings.warmStart = false;
@@ -229,13 +241,13 @@ TEST(FilteredPcg, ReachesTheToleranceOnTheTrueResidual) {
   }
 }
 
-TEST(FilteredPcg, MatchesSimplicialLdltWithoutConstraints) {
+TEST_P(FilteredPcgTest, MatchesSimplicialLdltWithoutConstraints) {
   const RandomSystem system = makeRandomSystem(600, 2);
   VertexFilter filter;
   filter.resize(600);
   FilteredPcg pcg;
   Vec3Array deltaV;
-  const SolveReport report = pcg.solve(system.A, system.b, filter, tightSettings(), deltaV);
+  const SolveReport report = pcg.solve(system.A, system.b, filter, tightSettings(GetParam()), deltaV);
   ASSERT_TRUE(report.converged);
 
   Eigen::SimplicialLDLT<Eigen::SparseMatrix<Real>> ldlt(system.A.toEigen());
@@ -245,7 +257,7 @@ TEST(FilteredPcg, MatchesSimplicialLdltWithoutConstraints) {
   EXPECT_LE(relativeError, 1e-8);
 }
 
-TEST(FilteredPcg, ConstraintsHoldExactlyAndFreePartMatchesTheReducedSystem) {
+TEST_P(FilteredPcgTest, ConstraintsHoldExactlyAndFreePartMatchesTheReducedSystem) {
   const Index vertexCount = 600;
   const RandomSystem system = makeRandomSystem(vertexCount, 3);
   std::mt19937 random(33);
@@ -285,7 +297,7 @@ TEST(FilteredPcg, ConstraintsHoldExactlyAndFreePartMatchesTheReducedSystem) {
   }
 
   for (bool warmStart : {false, true}) {
-    PcgSettings settings = tightSettings();
+    PcgSettings settings = tightSettings(GetParam());
     settings.warmStart = warmStart;
     FilteredPcg pcg;
     pcg.resize(vertexCount);
@@ -322,7 +334,7 @@ TEST(FilteredPcg, ConstraintsHoldExactlyAndFreePartMatchesTheReducedSystem) {
   }
 }
 
-TEST(FilteredPcg, WarmStartFromTheSolutionNeedsAtMostOneIteration) {
+TEST_P(FilteredPcgTest, WarmStartFromTheSolutionNeedsAtMostOneIteration) {
   const RandomSystem system = makeRandomSystem(500, 4);
   VertexFilter filter;
   filter.resize(500);
@@ -331,16 +343,16 @@ TEST(FilteredPcg, WarmStartFromTheSolutionNeedsAtMostOneIteration) {
   FilteredPcg pcg;
   pcg.resize(500);
   Vec3Array deltaV;
-  ASSERT_TRUE(pcg.solve(system.A, system.b, filter, tightSettings(), deltaV).converged);
+  ASSERT_TRUE(pcg.solve(system.A, system.b, filter, tightSettings(GetParam()), deltaV).converged);
 
-  PcgSettings settings;  // defaults: 1e-3, warm start
+  PcgSettings settings = settingsFor(GetParam());  // defaults: 1e-3, warm start
   const SolveReport report = pcg.solve(system.A, system.b, filter, settings, deltaV);
   EXPECT_TRUE(report.converged);
   EXPECT_LE(report.iterations, 1);
   EXPECT_LE(report.relativeResidual, 1e-3);
 }
 
-TEST(FilteredPcg, WarmStartFromANearbyGuessNeedsFewerIterationsThanCold) {
+TEST_P(FilteredPcgTest, WarmStartFromANearbyGuessNeedsFewerIterationsThanCold) {
   const RandomSystem system = makeRandomSystem(800, 5);
   VertexFilter filter;
   filter.resize(800);
@@ -348,9 +360,9 @@ TEST(FilteredPcg, WarmStartFromANearbyGuessNeedsFewerIterationsThanCold) {
   FilteredPcg pcg;
   pcg.resize(800);
   Vec3Array exact;
-  ASSERT_TRUE(pcg.solve(system.A, system.b, filter, tightSettings(), exact).converged);
+  ASSERT_TRUE(pcg.solve(system.A, system.b, filter, tightSettings(GetParam()), exact).converged);
 
-  PcgSettings settings;
+  PcgSettings settings = settingsFor(GetParam());
   settings.tolerance = 1e-6;
   settings.maxIterations = 1000;
   settings.warmStart = false;
@@ -372,12 +384,12 @@ TEST(FilteredPcg, WarmStartFromANearbyGuessNeedsFewerIterationsThanCold) {
   EXPECT_LE(filteredResidualNorm(system.A, system.b, filter, warm), 1e-6 * reference * (1 + 1e-6));
 }
 
-TEST(FilteredPcg, IterationCapIsRespectedAndReportedAsNotConverged) {
+TEST_P(FilteredPcgTest, IterationCapIsRespectedAndReportedAsNotConverged) {
   const RandomSystem system = makeRandomSystem(400, 6);
   VertexFilter filter;
   filter.resize(400);
   FilteredPcg pcg;
-  PcgSettings settings = tightSettings();
+  PcgSettings settings = tightSettings(GetParam());
   settings.maxIterations = 3;
   Vec3Array deltaV;
   const SolveReport report = pcg.solve(system.A, system.b, filter, settings, deltaV);
@@ -392,14 +404,14 @@ TEST(FilteredPcg, IterationCapIsRespectedAndReportedAsNotConverged) {
   EXPECT_EQ(none.iterations, 0);
 }
 
-TEST(FilteredPcg, NonFiniteInputEndsTheSolveAsNotConverged) {
+TEST_P(FilteredPcgTest, NonFiniteInputEndsTheSolveAsNotConverged) {
   const Index vertexCount = 300;
   VertexFilter filter;
   filter.resize(vertexCount);
   filter.setFixed(0, Vec3(1, 2, 3));
   FilteredPcg pcg;
   pcg.resize(vertexCount);
-  PcgSettings settings;
+  PcgSettings settings = settingsFor(GetParam());
   settings.maxIterations = 50;
   const Real nan = std::numeric_limits<Real>::quiet_NaN();
   const Real infinity = std::numeric_limits<Real>::infinity();
@@ -426,7 +438,7 @@ TEST(FilteredPcg, NonFiniteInputEndsTheSolveAsNotConverged) {
   }
 }
 
-TEST(FilteredPcg, NaNConfinedToAPinnedVertexDoesNotSpoilTheSolve) {
+TEST_P(FilteredPcgTest, NaNConfinedToAPinnedVertexDoesNotSpoilTheSolve) {
   // A pinned vertex's own row is filtered to exact zeros, so garbage there has no effect.
   RandomSystem system = makeRandomSystem(300, 8);
   VertexFilter filter;
@@ -435,19 +447,19 @@ TEST(FilteredPcg, NaNConfinedToAPinnedVertexDoesNotSpoilTheSolve) {
   system.b[20] = Vec3::Constant(std::numeric_limits<Real>::quiet_NaN());
   FilteredPcg pcg;
   Vec3Array deltaV;
-  const SolveReport report = pcg.solve(system.A, system.b, filter, tightSettings(), deltaV);
+  const SolveReport report = pcg.solve(system.A, system.b, filter, tightSettings(GetParam()), deltaV);
   EXPECT_TRUE(report.converged);
   EXPECT_EQ(deltaV[20], Vec3(0, 0, 1));
 }
 
-TEST(FilteredPcg, VanishingRightHandSideStopsAtTheAbsoluteFloor) {
+TEST_P(FilteredPcgTest, VanishingRightHandSideStopsAtTheAbsoluteFloor) {
   RandomSystem system = makeRandomSystem(300, 9);
   for (Vec3& v : system.b) v.setZero();
   VertexFilter filter;
   filter.resize(300);
   filter.setFixed(3, Vec3::Zero());
   FilteredPcg pcg;
-  PcgSettings settings;
+  PcgSettings settings = settingsFor(GetParam());
 
   // Cold: the start (I − S)z = 0 is already the exact answer.
   settings.warmStart = false;
@@ -470,7 +482,7 @@ TEST(FilteredPcg, VanishingRightHandSideStopsAtTheAbsoluteFloor) {
   EXPECT_LE(report.relativeResidual, 1);
 }
 
-TEST(FilteredPcg, RepeatedSolvesGiveTheSameBits) {
+TEST_P(FilteredPcgTest, RepeatedSolvesGiveTheSameBits) {
   const RandomSystem system = makeRandomSystem(900, 10);
   VertexFilter filter;
   filter.resize(900);
@@ -479,23 +491,31 @@ TEST(FilteredPcg, RepeatedSolvesGiveTheSameBits) {
   FilteredPcg second;
   Vec3Array a;
   Vec3Array b;
-  const SolveReport reportA = first.solve(system.A, system.b, filter, PcgSettings{}, a);
-  const SolveReport reportB = second.solve(system.A, system.b, filter, PcgSettings{}, b);
+  const SolveReport reportA = first.solve(system.A, system.b, filter, settingsFor(GetParam()), a);
+  const SolveReport reportB = second.solve(system.A, system.b, filter, settingsFor(GetParam()), b);
   EXPECT_EQ(reportA.iterations, reportB.iterations);
   EXPECT_EQ(reportA.relativeResidual, reportB.relativeResidual);
   for (Index i = 0; i < 900; ++i) ASSERT_EQ(a[i], b[i]) << "vertex " << i;
 }
 
-TEST(FilteredPcg, MismatchedSizesAreRejected) {
+TEST_P(FilteredPcgTest, MismatchedSizesAreRejected) {
   const RandomSystem system = makeRandomSystem(50, 11);
   VertexFilter filter;
   filter.resize(49);
   FilteredPcg pcg;
   Vec3Array deltaV(50, Vec3::Ones());
-  const SolveReport report = pcg.solve(system.A, system.b, filter, PcgSettings{}, deltaV);
+  const SolveReport report = pcg.solve(system.A, system.b, filter, settingsFor(GetParam()), deltaV);
   EXPECT_FALSE(report.converged);
   EXPECT_EQ(deltaV[0], Vec3::Ones());
 }
+
+INSTANTIATE_TEST_SUITE_P(Preconditioners, FilteredPcgTest,
+                         ::testing::Values(PreconditionerKind::BlockJacobi,
+                                           PreconditionerKind::MulticolorGaussSeidel),
+                         [](const ::testing::TestParamInfo<PreconditionerKind>& info) {
+                           return info.param == PreconditionerKind::BlockJacobi ? "BlockJacobi"
+                                                                                : "GaussSeidel";
+                         });
 
 }  // namespace
 }  // namespace weft

@@ -49,6 +49,7 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   pcgSettings.tolerance = m_settings.cgTolerance;
   pcgSettings.maxIterations = m_settings.cgMaxIterations;
   pcgSettings.warmStart = true;  // the caller prepares the initial guess in m_correction
+  pcgSettings.preconditioner = m_settings.preconditioner;
   WEFT_PROFILE_ZONE("solve");
   const std::int64_t start = FrameClock::nowNs();
   const SolveReport solve = m_pcg.solve(system.systemMatrix(), m_rowRightHandSide, m_filter,

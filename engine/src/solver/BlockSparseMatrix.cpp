@@ -2,6 +2,7 @@
 #include <solver/BlockSparseMatrix.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cassert>
 
 namespace weft {
@@ -53,6 +54,10 @@ void BlockSparseMatrix::build(Index blockRows,
   }
   m_columns.shrink_to_fit();
   m_blocks.assign(m_columns.size(), Mat3::Zero());
+  // Unique across all matrices of the process, so a cache keyed on it cannot mistake a new
+  // matrix (perhaps at the address of an old one) for the pattern it was built from.
+  static std::atomic<std::uint64_t> nextPatternId{1};
+  m_patternId = nextPatternId.fetch_add(1, std::memory_order_relaxed);
 }
 
 Index BlockSparseMatrix::slot(Index row, Index col) const {

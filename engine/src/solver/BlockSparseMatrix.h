@@ -23,6 +23,7 @@
 #include <Eigen/SparseCore>
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -42,6 +43,10 @@ class BlockSparseMatrix {
   /// always present. Every index must be < blockRows (asserted; skipped in release builds).
   /// All blocks start at zero. Allocates; call at set-up time only.
   void build(Index blockRows, std::span<const std::array<Index, 2>> coupledPairs);
+
+  /// Identifies the pattern: a fresh nonzero value at every build(), kept by copies, 0 before the
+  /// first build. Lets pattern-dependent caches (MulticolorOrdering) know when to rebuild.
+  std::uint64_t patternId() const { return m_patternId; }
 
   /// Number of block rows (= block columns = vertices).
   Index blockRows() const { return static_cast<Index>(m_diagonalSlots.size()); }
@@ -100,6 +105,7 @@ class BlockSparseMatrix {
   std::vector<Index> m_columns;        ///< block column per slot, ascending within a row
   std::vector<Index> m_diagonalSlots;  ///< slot of (r, r) per row
   std::vector<Mat3> m_blocks;          ///< one block per slot
+  std::uint64_t m_patternId = 0;       ///< see patternId()
 };
 
 }  // namespace weft

@@ -1,6 +1,7 @@
 // FilteredPcg: BW98 §5.3 modified PCG. See the design note in the header for the method, the
 // stopping rule and the determinism scheme; the kernels below are the per-range sweeps it runs.
 #include <solver/FilteredPcg.h>
+#include <solver/MulticolorOrdering.h>
 
 #include <algorithm>
 #include <cmath>
@@ -128,6 +129,121 @@ Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const V
   return sum;
 }
 
+// --- Multicolour symmetric Gauss–Seidel with Eisenstat's trick (header, "Gauss–Seidel"). With
+// --- Ã = L̃ + D̃ + Ũ split by colour (L̃: blocks to earlier colours), P_L = D̃ + L̃, P_U = D̃ + Ũ = P_Lᵀ.
+// --- A sweep over one colour's vertices order[begin … end) reads only other colours' entries,
+// --- which earlier colours (forward) or later colours (backward) have finished; vertices of one
+// --- colour share no block, so a colour's vertices can run in any order or at once. S_i on every
+// --- output keeps the vectors exactly in the free subspace (exact zeros for fixed vertices).
+
+/// The off-diagonal blocks of A in the ordering's sweep order (lower and upper entries), copied
+/// once per solve so the sweeps read them front to back.
+struct PackedBlocks {
+  const std::vector<Mat3>& lower;
+  const std::vector<Mat3>& upper;
+};
+
+/// Copies the blocks of the entries of sweep positions [begin, end) into packed order.
+void packRange(Index begin, Index end, const BlockSparseMatrix& A,
+               const MulticolorOrdering& ordering, std::vector<Mat3>& lower,
+               std::vector<Mat3>& upper) {
+  for (Index e = ordering.lowerBegin(begin), last = ordering.lowerBegin(end); e < last; ++e) {
+    lower[e] = A.block(ordering.lowerSlots()[e]);
+  }
+  for (Index e = ordering.upperBegin(begin), last = ordering.upperBegin(end); e < last; ++e) {
+    upper[e] = A.block(ordering.upperSlots()[e]);
+  }
+}
+
+/// Backward sweep over sweep positions [begin, end) of one colour, t = P_U⁻¹ c:
+/// t_i = D̃_i⁻¹(c_i − Σ_{later j} A_ij t_j), and u_i = S_i Σ_{later j} A_ij t_j = c_i − D̃_i t_i, the
+/// input of the forward sweep (stored in w).
+void backwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
+                        const MulticolorOrdering& ordering, const VertexFilter& filter,
+                        const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c, Vec3Array& t,
+                        Vec3Array& w) {
+  const Index* columns = ordering.upperColumns().data();
+  const Mat3* upper = blocks.upper.data();
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = ordering.order()[k];
+    Vec3 sum = Vec3::Zero();
+    for (Index e = ordering.upperBegin(k), last = ordering.upperBegin(k + 1); e < last; ++e) {
+      sum.noalias() += upper[e] * t[columns[e]];
+    }
+    t[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * (c[vertex] - sum));
+    w[vertex] = filter.filter(vertex, sum);
+  }
+}
+
+/// Forward sweep over sweep positions [begin, end) of one colour, in place, w = P_L⁻¹ w:
+/// w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j). With curvature, returns Σ c_iᵀ(t_i + w_i) over the
+/// range (ĉᵀÂĉ, Â = P_L⁻¹ Ã P_U⁻¹).
+template <bool curvature>
+Real forwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
+                       const MulticolorOrdering& ordering, const VertexFilter& filter,
+                       const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c,
+                       const Vec3Array& t, Vec3Array& w) {
+  const Index* columns = ordering.lowerColumns().data();
+  const Mat3* lower = blocks.lower.data();
+  Real sum = 0;
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = ordering.order()[k];
+    Vec3 rest = w[vertex];
+    for (Index e = ordering.lowerBegin(k), last = ordering.lowerBegin(k + 1); e < last; ++e) {
+      rest.noalias() -= lower[e] * w[columns[e]];
+    }
+    w[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * rest);
+    if constexpr (curvature) sum += c[vertex].dot(t[vertex] + w[vertex]);
+  }
+  return sum;
+}
+
+/// ŝ = D̃ r̂ over the range (the transformed system's preconditioner); returns Σ r̂ᵀŝ.
+Real diagonalRange(Index begin, Index end, const BlockSparseMatrix& A, const VertexFilter& filter,
+                   const Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    s[vertex] = filter.filter(vertex, A.block(A.diagonalSlot(vertex)) * r[vertex]);
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// Δv += α t, r̂ −= α (t + w), ŝ = D̃ r̂ over the range; returns Σ r̂ᵀŝ.
+Real transformedUpdateRange(Index begin, Index end, Real alpha, const BlockSparseMatrix& A,
+                            const VertexFilter& filter, const Vec3Array& t, const Vec3Array& w,
+                            Vec3Array& deltaV, Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index vertex = begin; vertex < end; ++vertex) {
+    deltaV[vertex] += alpha * t[vertex];
+    r[vertex] -= alpha * (t[vertex] + w[vertex]);
+    s[vertex] = filter.filter(vertex, A.block(A.diagonalSlot(vertex)) * r[vertex]);
+    sum += r[vertex].dot(s[vertex]);
+  }
+  return sum;
+}
+
+/// The true residual r = P_L r̂ = ŝ + S L̃ r̂ (ŝ = D̃ r̂) over sweep positions [begin, end); returns
+/// Σ rᵀD̃⁻¹r, the stopping norm². Positions are independent: any split gives the same bits.
+Real untransformedNormRange(Index begin, Index end, const PackedBlocks& blocks,
+                            const MulticolorOrdering& ordering, const VertexFilter& filter,
+                            const std::vector<Mat3>& inverseDiagonal, const Vec3Array& r,
+                            const Vec3Array& s) {
+  const Index* columns = ordering.lowerColumns().data();
+  const Mat3* lower = blocks.lower.data();
+  Real sum = 0;
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = ordering.order()[k];
+    Vec3 product = Vec3::Zero();
+    for (Index e = ordering.lowerBegin(k), last = ordering.lowerBegin(k + 1); e < last; ++e) {
+      product.noalias() += lower[e] * r[columns[e]];
+    }
+    const Vec3 residual = s[vertex] + filter.filter(vertex, product);
+    sum += residual.dot(inverseDiagonal[vertex] * residual);
+  }
+  return sum;
+}
+
 /// c = S(s + β c) over the range. s and c are in the free subspace already; filtering again
 /// removes the rounding that would otherwise let constrained components creep.
 void directionRange(Index begin, Index end, Real beta, const VertexFilter& filter,
@@ -144,6 +260,7 @@ void FilteredPcg::resize(Index vertexCount) {
   m_preconditioned.assign(vertexCount, Vec3::Zero());
   m_direction.assign(vertexCount, Vec3::Zero());
   m_product.assign(vertexCount, Vec3::Zero());
+  m_backward.assign(vertexCount, Vec3::Zero());
   m_inverseDiagonal.assign(vertexCount, Mat3::Zero());
   m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
 }
@@ -169,6 +286,20 @@ Real FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
 }
 
 template <typename Kernel>
+void FilteredPcg::forEachInRange(Index count, Kernel&& kernel) {
+  // parallelFor runs a single block inline (no fork): a colour smaller than a block costs nothing
+  // in task overhead, which matters since a sweep visits every colour twice per iteration.
+  if (m_tasks) {
+    m_tasks->parallelFor(count, kReductionBlock,
+                         [&](Index begin, Index end, int) { kernel(begin, end); });
+    return;
+  }
+  for (Index begin = 0; begin < count; begin += kReductionBlock) {
+    kernel(begin, std::min(begin + kReductionBlock, count));
+  }
+}
+
+template <typename Kernel>
 void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
   if (m_tasks) {
     m_tasks->parallelFor(vertexCount, kReductionBlock,
@@ -178,6 +309,83 @@ void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
   for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
     kernel(begin, std::min(begin + kReductionBlock, vertexCount));
   }
+}
+
+template <typename Kernel>
+Real FilteredPcg::sumInRange(Index count, Kernel&& kernel) {
+  if (m_tasks) {
+    return m_tasks->parallelReduce(
+        count, kReductionBlock, Real(0), [&](Index begin, Index end) { return kernel(begin, end); },
+        [](Real sum, Real partial) { return sum + partial; });
+  }
+  Real sum = 0;
+  for (Index begin = 0; begin < count; begin += kReductionBlock) {
+    sum += kernel(begin, std::min(begin + kReductionBlock, count));
+  }
+  return sum;
+}
+
+void FilteredPcg::prepareGaussSeidel(const BlockSparseMatrix& A) {
+  if (!m_ordering.matches(A)) {
+    // A new pattern (set-up, or a topology change): colour it, size the packed blocks. Allocates.
+    m_ordering.build(A);
+    m_lowerBlocks.resize(m_ordering.lowerSlots().size());
+    m_upperBlocks.resize(m_ordering.upperSlots().size());
+  }
+  forEachBlock(A.blockRows(), [&](Index begin, Index end) {
+    packRange(begin, end, A, m_ordering, m_lowerBlocks, m_upperBlocks);
+  });
+}
+
+template <bool curvature>
+Real FilteredPcg::forwardSweep(const VertexFilter& filter,
+                               const Vec3Array& c, const Vec3Array& t, Vec3Array& w) {
+  // Colour by colour; a colour's partial sums in block order, the colours' sums in colour order:
+  // one summation order whatever the thread count.
+  Real sum = 0;
+  for (Index color = 0; color < m_ordering.colorCount(); ++color) {
+    const Index first = m_ordering.colorBegin(color);
+    sum += sumInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+      return forwardSweepRange<curvature>(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering,
+                                          filter, m_inverseDiagonal, c, t, w);
+    });
+  }
+  return sum;
+}
+
+void FilteredPcg::backwardSweep(const VertexFilter& filter,
+                                const Vec3Array& c, Vec3Array& t, Vec3Array& w) {
+  for (Index color = m_ordering.colorCount(); color-- > 0;) {
+    const Index first = m_ordering.colorBegin(color);
+    forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+      backwardSweepRange(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
+                         m_inverseDiagonal, c, t, w);
+    });
+  }
+}
+
+void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                      PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
+                                      TaskSystem* tasks) {
+  m_tasks = tasks;
+  const Index vertexCount = A.blockRows();
+  if (m_residual.size() != vertexCount) resize(vertexCount);
+  z.resize(vertexCount);
+  forEachBlock(vertexCount, [&](Index begin, Index end) {
+    buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
+  });
+  if (kind != PreconditionerKind::MulticolorGaussSeidel) {
+    for (Index vertex = 0; vertex < vertexCount; ++vertex) z[vertex] = m_inverseDiagonal[vertex] * r[vertex];
+    return;
+  }
+  prepareGaussSeidel(A);
+  Vec3Array& w = m_product;
+  std::copy(r.begin(), r.end(), w.begin());
+  forwardSweep<false>(filter, m_direction, m_backward, w);  // w = P_L⁻¹ r
+  sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return diagonalRange(begin, end, A, filter, w, m_preconditioned);  // D̃ w
+  });
+  backwardSweep(filter, m_preconditioned, z, m_residual);  // z = P_U⁻¹ D̃ w
 }
 
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
@@ -202,11 +410,13 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   Vec3Array& r = m_residual;
   Vec3Array& s = m_preconditioned;
   Vec3Array& c = m_direction;
-  Vec3Array& q = m_product;
 
   forEachBlock(vertexCount, [&](Index begin, Index end) {
     buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
   });
+  const bool gaussSeidel = settings.preconditioner == PreconditionerKind::MulticolorGaussSeidel;
+  // The colouring depends on the pattern only: rebuilt (allocating) when the topology changes.
+  if (gaussSeidel) prepareGaussSeidel(A);
 
   // The reference r_ref = S(b − A(I − S)z). A cold start begins exactly there, so it is the initial
   // residual; a warm start needs it separately, and needs the SpMV only when some target is nonzero.
@@ -229,39 +439,59 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
 
   forEachBlock(vertexCount,
                [&](Index begin, Index end) { startRange(begin, end, filter, warmStart, deltaV); });
-  Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+  // stopDelta = rᵀD̃⁻¹r drives the stopping rule; delta = rᵀs = rᵀP⁻¹r drives CG. They are one
+  // number for block Jacobi (s = D̃⁻¹r).
+  Real stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
     return residualRange(begin, end, A, b, filter, m_inverseDiagonal, deltaV, r, s);
   });
-  if (!warmStart) referenceDelta = delta;
+  if (!warmStart) referenceDelta = stopDelta;
 
   // rᵀP̃⁻¹r ≥ 0 in exact arithmetic; clamp rounding below zero before the square root.
   const Real referenceNorm = std::sqrt(std::max(referenceDelta, Real(0)));
-  const Real threshold = std::max(settings.tolerance * referenceNorm, settings.absoluteTolerance);
-  const Real denominator = std::max(referenceNorm, settings.absoluteTolerance);
-  const bool referenceFinite = std::isfinite(referenceDelta);
+  const Stopping stopping{std::max(settings.tolerance * referenceNorm, settings.absoluteTolerance),
+                          std::max(referenceNorm, settings.absoluteTolerance),
+                          std::isfinite(referenceDelta), settings.maxIterations};
+  if (gaussSeidel) {
+    iterateGaussSeidel(A, filter, stopping, stopDelta, deltaV, report);
+  } else {
+    iterateJacobi(A, filter, stopping, stopDelta, deltaV, report);
+  }
+  return report;
+}
 
+/// Fills the report's residual fields from the stopping norm² and says whether it converged.
+bool FilteredPcg::Stopping::judge(Real stopDelta, SolveReport& report) const {
+  // NaN compares false with everything, so test finiteness first: a NaN residual must end the
+  // loop as a failure, never look converged and never spin until the cap.
+  if (!referenceFinite || !std::isfinite(stopDelta)) {
+    report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
+    report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
+    report.converged = false;
+    return false;
+  }
+  report.residualNorm = std::sqrt(std::max(stopDelta, Real(0)));
+  // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
+  report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
+                            : report.residualNorm == 0 ? Real(0)
+                                                       : std::numeric_limits<Real>::infinity();
+  report.converged = report.residualNorm <= threshold;
+  return report.converged;
+}
+
+void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                const Stopping& stopping, Real delta, Vec3Array& deltaV,
+                                SolveReport& report) {
+  const Index vertexCount = A.blockRows();
+  Vec3Array& r = m_residual;
+  Vec3Array& s = m_preconditioned;
+  Vec3Array& c = m_direction;
+  Vec3Array& q = m_product;
   forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
 
   Real previousDelta = delta;
   for (;;) {
-    // NaN compares false with everything, so test finiteness first: a NaN residual must end the
-    // loop as a failure, never look converged and never spin until the cap.
-    if (!referenceFinite || !std::isfinite(delta)) {
-      report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
-      report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
-      report.converged = false;
-      break;
-    }
-    report.residualNorm = std::sqrt(std::max(delta, Real(0)));
-    // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
-    report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
-                              : report.residualNorm == 0 ? Real(0)
-                                                         : std::numeric_limits<Real>::infinity();
-    if (report.residualNorm <= threshold) {
-      report.converged = true;
-      break;
-    }
-    if (report.iterations >= settings.maxIterations) break;
+    if (stopping.judge(delta, report) || !std::isfinite(report.residualNorm)) break;
+    if (report.iterations >= stopping.maxIterations) break;
 
     if (report.iterations > 0) {
       const Real beta = delta / previousDelta;
@@ -288,7 +518,74 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
     });
     ++report.iterations;
   }
-  return report;
+}
+
+void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
+                                     const Stopping& stopping, Real startStopDelta,
+                                     Vec3Array& deltaV, SolveReport& report) {
+  const Index vertexCount = A.blockRows();
+  Vec3Array& r = m_residual;        // r̂ = P_L⁻¹ r
+  Vec3Array& s = m_preconditioned;  // ŝ = D̃ r̂
+  Vec3Array& c = m_direction;       // ĉ
+  Vec3Array& t = m_backward;        // t = P_U⁻¹ ĉ, the search direction in Δv's space
+  Vec3Array& w = m_product;         // u, then w = P_L⁻¹ u; Â ĉ = t + w
+
+  // The start's residual is exact (residualRange); a bad one ends the solve before any sweep.
+  if (stopping.judge(startStopDelta, report) || !std::isfinite(report.residualNorm)) return;
+  if (stopping.maxIterations <= 0) return;
+
+  forwardSweep<false>(filter, c, t, r);  // r̂ = P_L⁻¹ r, in place
+  Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return diagonalRange(begin, end, A, filter, r, s);
+  });
+  forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
+  // ‖r‖²_{M⁻¹} = r̂ᵀD̃r̂ = delta (M the SGS preconditioner) falls with CG's iterations; its ratio to
+  // the start scales the start's exact ‖r‖_{D̃⁻¹} into an estimate, and the exact norm (one
+  // half-SpMV) is computed only once the estimate is below the threshold.
+  const Real startDelta = delta;
+  const Real startNorm = report.residualNorm;
+  auto exactStopDelta = [&] {
+    return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return untransformedNormRange(begin, end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
+                                    m_inverseDiagonal, r, s);
+    });
+  };
+
+  Real previousDelta = delta;
+  for (;;) {
+    if (!std::isfinite(delta)) {
+      stopping.judge(std::numeric_limits<Real>::quiet_NaN(), report);
+      break;
+    }
+    if (report.iterations > 0) {
+      const Real estimate =
+          startDelta > 0 ? startNorm * std::sqrt(std::max(delta, Real(0)) / startDelta) : Real(0);
+      if (estimate <= stopping.threshold || report.iterations >= stopping.maxIterations) {
+        if (stopping.judge(exactStopDelta(), report) || !std::isfinite(report.residualNorm)) break;
+      }
+      if (report.iterations >= stopping.maxIterations) break;
+      const Real beta = delta / previousDelta;
+      forEachBlock(vertexCount, [&](Index begin, Index end) {
+        directionRange(begin, end, beta, filter, s, c);
+      });
+    }
+    backwardSweep(filter, c, t, w);
+    const Real curvature = forwardSweep<true>(filter, c, t, w);
+    // ĉᵀÂĉ ≤ 0: breakdown (A not positive definite on the free subspace, or a NaN). Δv keeps the
+    // last finite iterate; the report gets that iterate's exact residual.
+    if (!(curvature > 0) || !std::isfinite(curvature)) {
+      if (!std::isfinite(curvature)) stopping.judge(std::numeric_limits<Real>::quiet_NaN(), report);
+      else if (report.iterations > 0) stopping.judge(exactStopDelta(), report);
+      report.converged = false;
+      break;
+    }
+    const Real alpha = delta / curvature;
+    previousDelta = delta;
+    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return transformedUpdateRange(begin, end, alpha, A, filter, t, w, deltaV, r, s);
+    });
+    ++report.iterations;
+  }
 }
 
 }  // namespace weft
