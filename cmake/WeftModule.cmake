@@ -70,7 +70,17 @@ function(weft_set_warnings target)
     endif()
   endif()
   if(WEFT_SANITIZE)
-    target_compile_options(${target} PUBLIC -fsanitize=${WEFT_SANITIZE} -fno-omit-frame-pointer)
-    target_link_options(${target} PUBLIC -fsanitize=${WEFT_SANITIZE})
+    # PUBLIC, so every executable that links a module is instrumented and linked the same way.
+    set(sanitizers ${WEFT_SANITIZE})
+    if(WEFT_SANITIZE MATCHES "undefined" AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+      # GCC leaves float-to-integer overflow out of -fsanitize=undefined (clang includes it);
+      # a NaN or huge coordinate cast to a grid cell or bucket index is exactly the UB to catch.
+      string(APPEND sanitizers ",float-cast-overflow")
+    endif()
+    # -fno-sanitize-recover=all: the first report aborts, so a finding fails its test instead of
+    # scrolling past in the log of a test that passes.
+    target_compile_options(${target} PUBLIC -fsanitize=${sanitizers} -fno-sanitize-recover=all
+                                            -fno-omit-frame-pointer)
+    target_link_options(${target} PUBLIC -fsanitize=${sanitizers})
   endif()
 endfunction()
