@@ -21,6 +21,7 @@
 #pragma once
 
 #include <weft/collision/SelfIntersectionCounter.h>
+#include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
 
 #include <gtest/gtest.h>

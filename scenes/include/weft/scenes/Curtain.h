@@ -11,6 +11,7 @@
 // Sizes ×1, ×4, ×16, ×64 keep the physical size and refine the grid (41 × 31 up to 321 × 241).
 #pragma once
 
+#include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
 
 #include <memory>
@@ -21,7 +22,7 @@ namespace weft {
 struct CurtainSettings {
   Index size = 1;  ///< refinement: 1, 4, 16 or 64 times the triangles of the 41 × 31 curtain
   ForceModel forceModel = ForceModel::BaraffWitkin;  ///< internal forces
-  ClothMaterial material;    ///< defaults: the cotton-like curtain material
+  ClothMaterial material = cottonFabric();  ///< the cotton preset (strain limit 0.10)
   SolverSettings solver;     ///< integrator and solver
   bool pinScript = true;     ///< run the rod script (gather and re-open); false keeps the rod still
   /// m, amplitude of gentle pleats the curtain starts with (z = a·sin(2πx / 0.25 m), fading to 0
