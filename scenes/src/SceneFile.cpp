@@ -185,6 +185,21 @@ class Reader {
     return true;
   }
 
+  // The "time" of keyframe `index` of a track: required, in seconds, ≥ 0 and later than the
+  // previous keyframe's.
+  void readKeyframeTime(const Json& key, const std::string& path, std::size_t index,
+                        Real previous, Real& time) {
+    if (!member(key, "time")) {
+      fail(child(path, "time"), "is missing; give the time in seconds");
+      return;
+    }
+    if (readReal(key, path, "time", time, Range::NonNegative, "s") && index > 0 && !(time > previous)) {
+      fail(child(path, "time"), "is " + formatNumber(time) +
+                                    " s; keyframe times must increase (the previous is " +
+                                    formatNumber(previous) + " s)");
+    }
+  }
+
   // Reads an optional [x, y, z]; keeps `out` when absent.
   bool readVec3(const Json& object, const std::string& path, std::string_view key, Vec3& out,
                 std::string_view unit, bool nonZero = false) {
@@ -460,13 +475,7 @@ std::optional<PinScript> readPinScript(Reader& reader, const Json& object, const
       if (!reader.expectObject(key, here, "a keyframe: time, translation, rotation, scale")) continue;
       reader.checkKeys(key, here, {"time", "translation", "rotation", "scale"});
       PinKeyframe frame = previous;  // unspecified values hold
-      if (!Reader::member(key, "time")) reader.fail(child(here, "time"), "is missing; give the time in seconds");
-      if (reader.readReal(key, here, "time", frame.time, Range::NonNegative, "s") && k > 0 &&
-          Reader::member(key, "time") && !(frame.time > previous.time)) {
-        reader.fail(child(here, "time"), "is " + formatNumber(frame.time) +
-                                             " s; keyframe times must increase (the previous is " +
-                                             formatNumber(previous.time) + " s)");
-      }
+      reader.readKeyframeTime(key, here, k, previous.time, frame.time);
       reader.readVec3(key, here, "translation", frame.translation, "m");
       reader.readVec3(key, here, "scale", frame.scale, "");
       if (Reader::member(key, "rotation")) script.rotates = true;
@@ -660,13 +669,7 @@ std::optional<ColliderDescription> readCollider(Reader& reader, const Json& obje
           if (!reader.expectObject(key, at, "a keyframe: time, position, rotation")) continue;
           reader.checkKeys(key, at, {"time", "position", "rotation"});
           ColliderKeyframe frame = previous;
-          if (!Reader::member(key, "time")) reader.fail(child(at, "time"), "is missing; give the time in seconds");
-          if (reader.readReal(key, at, "time", frame.time, Range::NonNegative, "s") && k > 0 &&
-              Reader::member(key, "time") && !(frame.time > previous.time)) {
-            reader.fail(child(at, "time"), "is " + formatNumber(frame.time) +
-                                               " s; keyframe times must increase (the previous is " +
-                                               formatNumber(previous.time) + " s)");
-          }
+          reader.readKeyframeTime(key, at, k, previous.time, frame.time);
           reader.readVec3(key, at, "position", frame.position, "m");
           if (Reader::member(key, "rotation")) collider.rotates = true;
           reader.readRotation(key, at, "rotation", frame.rotation);
@@ -785,13 +788,7 @@ void readWindScript(Reader& reader, const Json& script, SceneDescription& scene)
     if (!reader.expectObject(key, at, "a keyframe: time, wind")) continue;
     reader.checkKeys(key, at, {"time", "wind"});
     WindKeyframe frame = previous;
-    if (!Reader::member(key, "time")) reader.fail(child(at, "time"), "is missing; give the time in seconds");
-    if (reader.readReal(key, at, "time", frame.time, Range::NonNegative, "s") && k > 0 &&
-        Reader::member(key, "time") && !(frame.time > previous.time)) {
-      reader.fail(child(at, "time"), "is " + formatNumber(frame.time) +
-                                         " s; keyframe times must increase (the previous is " +
-                                         formatNumber(previous.time) + " s)");
-    }
+    reader.readKeyframeTime(key, at, k, previous.time, frame.time);
     reader.readVec3(key, at, "wind", frame.wind, "m/s");
     scene.windKeyframes.push_back(frame);
     previous = frame;
