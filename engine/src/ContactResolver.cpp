@@ -286,12 +286,16 @@ void ContactResolver::clampToColliders(const Vec3Array& start, Real h) {
 
 void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpeed,
                                    const std::vector<Real>& inverseMasses) {
+  // A pair already separating fast enough needs nothing: decided before the masses, whose held
+  // test queries the colliders.
   Vec3 relative = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) relative += contact.weights[k] * m_velocity[contact.vertices[k]];
+  const Real normalSpeed = relative.dot(contact.normal);
+  if (normalSpeed >= targetNormalSpeed) return;
   Real effectiveInverseMass = 0;
   std::array<Real, 4> inverseMass;
   for (int k = 0; k < 4; ++k) {
     inverseMass[k] = impulseInverseMass(contact.vertices[k], inverseMasses);
-    relative += contact.weights[k] * m_velocity[contact.vertices[k]];
     effectiveInverseMass += contact.weights[k] * contact.weights[k] * inverseMass[k];
   }
   if (effectiveInverseMass <= 0) return;  // all four pinned: nothing can move
@@ -313,8 +317,6 @@ void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpee
       effectiveInverseMass += contact.weights[k] * contact.weights[k] * inverseMass[k];
     }
   }
-  const Real normalSpeed = relative.dot(contact.normal);
-  if (normalSpeed >= targetNormalSpeed) return;
   const Real normalChange = targetNormalSpeed - normalSpeed;
   Vec3 change = normalChange * contact.normal;
   // Coulomb friction: remove at most μ·|Δu_n| of relative tangential speed.
