@@ -33,8 +33,8 @@ constexpr Real kDivergedSpeed = 1e4;
 // and the swept self-collision test sees only straight paths; none of them can follow a pin that
 // jumps far past its neighbours. Measured on stress scene 10 (pins of a hanging 13 × 9 cotton
 // sheet moved 10 m in one frame): in one substep the limiter stopped at its cap with 282 of 308
-// edges over the limit (strain 17.9 without self-collision, 31.8 with it, from an awake start);
-// at one edge per substep (178 substeps for that frame) the frame ends at the limit. Ordinary pin
+// edges over the limit (strain 17.9 at the frame's end with self-collision off, 31.8 with it on
+// and the cloth awake); at one edge per substep (178 substeps) the frame ends at the limit. Ordinary pin
 // motion (a curtain rail, a turning pole) moves far less than an edge per frame and is unchanged.
 constexpr Real kMaxPinTravelPerSubstep = 1.0;
 // Retries of a failed frame, each with twice the substeps: up to 8 times the planned number.
