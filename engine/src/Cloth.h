@@ -89,7 +89,8 @@ class Cloth final : public DynamicSystem {
   void wake() { m_wakeRequested = true; }
   bool sleeping() const { return m_sleeping; }
   /// Substeps this cloth takes for a frame of frameDt; `predictedUnstable` is set when an
-  /// explicit method would need more than maxSubsteps.
+  /// explicit method would need more than maxSubsteps. In automatic mode also enough that no
+  /// pin moves farther than an edge per substep towards the targets set for the frame.
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
 
   Status setPinTargets(std::span<const Vec3> targets);
@@ -111,6 +112,7 @@ class Cloth final : public DynamicSystem {
     bool sleeping = false, wakeRequested = false;
     Index quietFrames = 0;
     std::uint64_t sleepFingerprint = 0;
+    Real potentialEnergy = 0;  // J, what a sleeping cloth reports (m_lastPotential)
   };
   void save(SavedState& out) const;
   /// Restores a save of this cloth (sizes checked by the caller).
@@ -185,6 +187,10 @@ class Cloth final : public DynamicSystem {
   // Frame-start copies for rollback when a frame produces non-finite state.
   Vec3Array m_savedPositions, m_savedVelocities;
   Real m_frameStartPotential = 0;  // J, elastic + gravity at the frame start (first substep)
+  // J, the potential the last stepped frame reported (start of its last substep): a sleeping
+  // cloth has not moved since, so it reports this rather than nothing.
+  Real m_lastPotential = 0;
+  Real m_meanEdgeLength = 0;  // m, mean rest length of the mesh edges (pin travel per substep)
   // The end-of-attempt checks (strain, energy jump) against the frame start; see stepFrame().
   // Checks a stepped frame given the strain and kinetic energy at its start and end.
   HealthFailure checkFrameHealth(Real startStrain, Real startKinetic, Real endStrain,

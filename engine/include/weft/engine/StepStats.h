@@ -72,7 +72,9 @@ struct StepStats {
   /// into folds, does not count).
   Real maxStrain = 0;
   Real kineticEnergy = 0;      ///< J at the end of the frame
-  Real potentialEnergy = 0;    ///< J (elastic + gravity) at the start of the last substep
+  /// J (elastic + gravity) at the start of the last substep; a sleeping cloth, which has not
+  /// moved since, counts the value of its last stepped frame.
+  Real potentialEnergy = 0;
   Real maxSpeed = 0;           ///< m/s, fastest vertex at the end
   Index contacts = 0;          ///< cloth vertices touching a collider at the end
   Index selfContacts = 0;      ///< self-proximity pairs repelled (all substeps)

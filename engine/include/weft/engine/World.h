@@ -223,7 +223,8 @@ class World {
   /// m/s, current velocities.
   Result<std::span<const Vec3>> velocities(ClothId cloth) const;
   /// Substeps per frame that the cloth's settings give for this frame length (after the
-  /// stability estimate for explicit integrators).
+  /// stability estimate for explicit integrators, and for the pin targets set for the next frame:
+  /// see SolverSettings::substeps).
   Result<Index> plannedSubsteps(ClothId cloth, Real frameDt) const;
 
   /// Copies everything that decides how the world continues (see WorldState).
