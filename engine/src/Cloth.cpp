@@ -27,16 +27,6 @@ constexpr Real kBvhRefitMotionPerThickness = 0.02;
 // it (a 250 m/s projectile drags cloth at 250 m/s), while a blown-up explicit step passes it
 // within a few substeps.
 constexpr Real kDivergedSpeed = 1e4;
-// Automatic substepping moves no pin farther than this many mean rest edge lengths in one
-// substep. A pin is a kinematic driver: within a substep the implicit step is linearised about
-// the substep start, the strain limiter's Jacobi passes carry a correction about one edge each,
-// and the swept self-collision test sees only straight paths; none of them can follow a pin that
-// jumps far past its neighbours. Measured on stress scene 10 (pins of a hanging 13 × 9 cotton
-// sheet moved 10 m in one frame): in one substep the limiter stopped at its cap with 282 of 308
-// edges over the limit (strain 17.9 at the frame's end with self-collision off, 31.8 with it on
-// and the cloth awake); at one edge per substep (178 substeps) the frame ends at the limit. Ordinary pin
-// motion (a curtain rail, a turning pole) moves far less than an edge per frame and is unchanged.
-constexpr Real kMaxPinTravelPerSubstep = 1.0;
 // Retries of a failed frame, each with twice the substeps: up to 8 times the planned number.
 constexpr int kMaxRetries = 3;
 // A sleeping cloth watches colliders within this distance (m) beyond its contact thickness: far
@@ -148,6 +138,11 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
   if (solver.cgMaxIterations < 1) return "cloth settings: solver.cgMaxIterations must be at least 1";
   if (solver.newtonIterations < 0) return "cloth settings: solver.newtonIterations must be at least 0";
   if (solver.maxSubsteps < 1) return "cloth settings: solver.maxSubsteps must be at least 1";
+  if (!(solver.maxPinTravelPerSubstep >= 0) || !std::isfinite(solver.maxPinTravelPerSubstep)) {
+    return "cloth settings: solver.maxPinTravelPerSubstep = " +
+           std::to_string(solver.maxPinTravelPerSubstep) +
+           " must be a finite number of edge lengths >= 0 (0 = no limit)";
+  }
   if (!settings.translation.allFinite() || !settings.rotation.allFinite()) {
     return "cloth settings: translation or rotation contains NaN or infinity";
   }
@@ -329,15 +324,16 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
       substeps = solver.maxSubsteps;
       if (predictedUnstable) *predictedUnstable = true;
     }
-    // Pins are kinematic drivers: no substep may carry one farther than an edge (see
-    // kMaxPinTravelPerSubstep). Only a fast pin asks for more; the cap still holds.
+    // Pins are kinematic drivers: no substep may carry one farther than
+    // maxPinTravelPerSubstep edges (SolverSettings says why). Only a fast pin asks for more; the
+    // cap still holds.
     Real travel = 0;
     for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
       travel = std::max(travel, (m_pinEnd[k] - m_pinStart[k]).norm());
     }
-    const Real pinWanted =
-        std::ceil(travel / (kMaxPinTravelPerSubstep * m_meanEdgeLength) * (1 - 1e-9));
-    if (m_meanEdgeLength > 0 && pinWanted > Real(substeps)) {
+    const Real reach = solver.maxPinTravelPerSubstep * m_meanEdgeLength;
+    const Real pinWanted = reach > 0 ? std::ceil(travel / reach * (1 - 1e-9)) : 0;
+    if (pinWanted > Real(substeps)) {
       substeps = static_cast<Index>(std::min<Real>(pinWanted, Real(solver.maxSubsteps)));
     }
   } else if (!implicit && frameDt / substeps > m_stableStep && predictedUnstable) {

@@ -63,6 +63,32 @@ TEST(PinTeleport, PlannedSubstepsKeepEveryPinWithinAnEdge) {
   const ClothId fixedCloth = world.createCloth(model, fixed).value();
   ASSERT_TRUE(world.setPinTargets(fixedCloth, targets).ok());
   EXPECT_EQ(world.plannedSubsteps(fixedCloth, kFrameDt).value(), 2);
+  // The allowed travel is a setting: 4 edges a substep need a quarter of the substeps (rounded
+  // up), 0 turns the rule off.
+  ClothSettings looser = hangingCotton();
+  looser.solver.maxPinTravelPerSubstep = 4;
+  const ClothId looserCloth = world.createCloth(model, looser).value();
+  ASSERT_TRUE(world.setPinTargets(looserCloth, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(looserCloth, kFrameDt).value(),
+            Index(std::ceil(10.0 / (4 * meanEdgeLength(*model)) * (1 - 1e-9))));
+  ClothSettings off = hangingCotton();
+  off.solver.maxPinTravelPerSubstep = 0;
+  const ClothId offCloth = world.createCloth(model, off).value();
+  ASSERT_TRUE(world.setPinTargets(offCloth, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(offCloth, kFrameDt).value(), 1);
+}
+
+TEST(PinTeleport, ANegativeOrNonFinitePinTravelIsRefusedByName) {
+  World world;
+  for (Real bad : {Real(-1), std::nan("")}) {
+    ClothSettings settings = hangingCotton();
+    settings.solver.maxPinTravelPerSubstep = bad;
+    const Result<ClothId> cloth = world.createCloth(sheet(), settings);
+    ASSERT_FALSE(cloth.ok());
+    EXPECT_NE(cloth.error().message.find("maxPinTravelPerSubstep"), std::string::npos)
+        << cloth.error().message;
+  }
+  EXPECT_EQ(world.clothCount(), 0u);
 }
 
 TEST(PinTeleport, ClothFollowsATenMetreJumpWithinItsStrainLimit) {
