@@ -157,6 +157,16 @@ class Cloth final : public DynamicSystem {
   // a vertex too fast (checked every substep), None otherwise.
   HealthFailure runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
                    ClothFrameReport& report);
+  // One self-collision pass over the substep from m_stepStartPositions; adds to the report.
+  void resolveSelfCollision(Real h, std::span<ColliderFrame> colliders, ClothFrameReport& report);
+  // After the collision passes: strain limiting with the collider contacts held along their
+  // normals, then the collisions again, a few rounds (the limiter is on).
+  // Returns the edges the last limiter run left over (`edgesOverLimit`, the first run's, when
+  // nothing was over).
+  Index limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bool selfCollision,
+                             Index edgesOverLimit, ClothFrameReport& report);
+  // The colliders near the substep's start and current positions, into m_nearColliders.
+  void selectResponseColliders(std::span<const ColliderFrame> colliders);
   // Colliders whose box comes within the contact distance of `points` go to m_nearColliders;
   // counts both kinds in m_stages.
   void selectNearColliders(std::span<const ColliderFrame> colliders, const Aabb& points,
@@ -204,6 +214,8 @@ class Cloth final : public DynamicSystem {
   // Null when ClothMaterial::strainLimit is 0 or infinite (off).
   std::unique_ptr<StrainLimiter> m_strainLimiter;
   StrainLimitSettings m_strainLimitSettings;
+  ContactHolds m_contactHolds;                     // with the limiter: this substep's contacts
+  std::vector<Real> m_heldInverseMasses;           // 0 also for vertices on two surfaces
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
   ClothStageCounters m_stages;                     // this frame's

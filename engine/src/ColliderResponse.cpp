@@ -6,6 +6,12 @@
 #include <cmath>
 
 namespace weft {
+namespace {
+
+// Two contact normals closer than this (cosine) are one surface for ContactHolds.
+constexpr Real kSameNormal = 0.999;
+
+}  // namespace
 
 RigidMotion advanceMotion(const RigidMotion& motion, Real dt) {
   RigidMotion moved = motion;
@@ -140,7 +146,8 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
                                                  const Vec3Array& xStart, const Vec3Array& vStart,
                                                  Real thickness,
                                                  const std::vector<char>& pinned, Vec3Array& x,
-                                                 Vec3Array& v) const {
+                                                 Vec3Array& v, ContactHolds* holds,
+                                                 bool friction) const {
   ColliderResponseReport report;
   report.constrainedVertices = Index(m_constrained.size());
   if (colliders.empty()) return report;
@@ -168,11 +175,20 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
       const Real normalChange =
           std::max<Real>(0, (v[i] - vStart[i]).dot(contact.normal)) + std::max<Real>(0, -normalSpeed);
       const Real tangentialSpeed = tangential.norm();
-      if (tangentialSpeed > 0) {
+      if (friction && tangentialSpeed > 0) {
         const Real kept = std::max<Real>(0, 1 - collider.friction * normalChange / tangentialSpeed);
         tangential *= kept;
       }
       v[i] = contact.velocity + normalPart + tangential;
+      if (holds) {
+        // A second surface at an angle to the first leaves the vertex no direction to slide in.
+        Vec3& held = holds->normals[i];
+        if (held.isZero()) {
+          held = contact.normal;
+        } else if (std::abs(held.dot(contact.normal)) < kSameNormal) {
+          holds->fixed[i] = 1;
+        }
+      }
       touched = true;
     }
     report.contacts += touched ? 1 : 0;

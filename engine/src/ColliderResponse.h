@@ -26,6 +26,7 @@
 #include <weft/Math.h>
 #include <weft/collision/Shape.h>
 
+#include <algorithm>
 #include <optional>
 #include <span>
 #include <vector>
@@ -73,6 +74,18 @@ struct ColliderResponseReport {
   Index sweptHits = 0;            ///< contacts found only by the continuous test
 };
 
+/// Which vertices the response left on a collider's surface, for a strain-limiting pass that
+/// must not undo it (StrainLimiter::applyInContact). Sized to the vertex count by the caller.
+struct ContactHolds {
+  Vec3Array normals;          ///< the contact normal of a vertex on one surface, zero otherwise
+  std::vector<char> fixed;    ///< 1 for a vertex on two surfaces that meet at an angle
+  /// Forgets every hold (no allocation once sized).
+  void clear() {
+    std::fill(normals.begin(), normals.end(), Vec3::Zero());
+    std::fill(fixed.begin(), fixed.end(), char(0));
+  }
+};
+
 class ColliderResponse {
  public:
   /// Constrains vertices predicted to end within `thickness` of a collider (implicit solve).
@@ -85,9 +98,13 @@ class ColliderResponse {
 
   /// After a step from xStart to (x, v): continuous test, projection, inelastic normal velocity
   /// and friction. `vStart` is the velocity before the step (for the normal velocity change).
+  /// With `holds`, every vertex it leaves in contact is recorded there (not cleared first).
+  /// `friction` false runs the pass again after a first one without taking friction twice: it
+  /// only projects and makes the normal velocity non-negative.
   ColliderResponseReport resolve(std::span<const ColliderFrame> colliders, const Vec3Array& xStart,
                                  const Vec3Array& vStart, Real thickness,
-                                 const std::vector<char>& pinned, Vec3Array& x, Vec3Array& v) const;
+                                 const std::vector<char>& pinned, Vec3Array& x, Vec3Array& v,
+                                 ContactHolds* holds = nullptr, bool friction = true) const;
 
  private:
   std::vector<Index> m_constrained;

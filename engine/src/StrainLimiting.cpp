@@ -12,6 +12,10 @@ namespace {
 // An edge's test and impulse cost about what a vertex update does (a subtraction, a square root,
 // a few products), so edges use the per-vertex grain: the curtain's 3,670 edges are 2 blocks.
 constexpr TaskSystem::Index kGrainEdges = kGrainVertices;
+// An edge whose held weight (applyInContact) is below this fraction of its free weight is taken
+// as uncorrectable: its two ends lie (nearly) along their contact normals, and the impulse that
+// would fix it through the small remainder grows without bound.
+constexpr Real kSmallestHeldWeight = 1e-3;
 
 }  // namespace
 
@@ -42,9 +46,65 @@ StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
 StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
                                        std::span<const Real> inverseMasses, Real h,
                                        std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
+  return run(settings, inverseMasses, {}, h, x, v, tasks);
+}
+
+StrainLimitReport StrainLimiter::applyInContact(const StrainLimitSettings& settings,
+                                                std::span<const Real> inverseMasses,
+                                                std::span<const Vec3> contactNormals, Real h,
+                                                std::span<Vec3> x, std::span<Vec3> v,
+                                                TaskSystem& tasks) {
+  assert(contactNormals.size() == m_correctionCount.size() &&
+         "StrainLimiter::applyInContact: one contact normal (zero: none) per vertex");
+  return run(settings, inverseMasses, contactNormals, h, x, v, tasks);
+}
+
+void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasses,
+                          std::span<const Vec3> contactNormals, Real inverseStep, bool backward,
+                          std::span<Vec3> x, std::span<Vec3> v) const {
+  const Index edgeCount = Index(m_edges.size());
+  const bool inContact = !contactNormals.empty();
+  for (Index k = 0; k < edgeCount; ++k) {
+    const LimitedEdge& edge = m_edges[backward ? edgeCount - 1 - k : k];
+    const Real weightA = inverseMasses[edge.a], weightB = inverseMasses[edge.b];
+    const Real weightSum = weightA + weightB;
+    const Vec3 delta = x[edge.b] - x[edge.a];
+    const Real length = delta.norm();
+    const Real longest = stretchFactor * edge.restLength;
+    if (!(length > longest) || weightSum == 0) continue;
+    Vec3 shiftA, shiftB;
+    if (inContact) {
+      const Vec3& normalA = contactNormals[edge.a];
+      const Vec3& normalB = contactNormals[edge.b];
+      const Vec3 direction = delta / length;
+      const Real alongA = normalA.dot(direction), alongB = normalB.dot(direction);
+      const Real held = weightA * (1 - alongA * alongA) + weightB * (1 - alongB * alongB);
+      if (!(held > kSmallestHeldWeight * weightSum)) continue;
+      const Vec3 impulse = ((length - longest) / held) * direction;
+      shiftA = weightA * impulse;
+      shiftA -= normalA.dot(shiftA) * normalA;
+      shiftB = -weightB * impulse;
+      shiftB -= normalB.dot(shiftB) * normalB;
+    } else {
+      const Vec3 impulse = ((length - longest) / (weightSum * length)) * delta;
+      shiftA = weightA * impulse;
+      shiftB = -weightB * impulse;
+    }
+    x[edge.a] += shiftA;
+    v[edge.a] += inverseStep * shiftA;
+    x[edge.b] += shiftB;
+    v[edge.b] += inverseStep * shiftB;
+  }
+}
+
+StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
+                                     std::span<const Real> inverseMasses,
+                                     std::span<const Vec3> contactNormals, Real h,
+                                     std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
   const Index vertexCount = Index(m_correctionCount.size());
   assert(x.size() == vertexCount && v.size() == vertexCount && inverseMasses.size() == vertexCount &&
          "StrainLimiter::apply: one position, velocity and inverse mass per vertex");
+  const bool inContact = !contactNormals.empty();
   assert(h > 0 && settings.limit > 0 && std::isfinite(settings.limit) &&
          "StrainLimiter::apply: needs h > 0 and a finite limit > 0 (0 or infinity means off: "
          "do not call)");
@@ -64,10 +124,21 @@ StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
           Index blockOver = 0;
           for (Index e = begin; e < end; ++e) {
             const LimitedEdge& edge = m_edges[e];
-            const Real weightSum = inverseMasses[edge.a] + inverseMasses[edge.b];
+            Real weightSum = inverseMasses[edge.a] + inverseMasses[edge.b];
             const Vec3 delta = x[edge.b] - x[edge.a];
             const Real length = delta.norm();
             const Real longest = stretchFactor * edge.restLength;
+            if (inContact && length > longest && weightSum > 0) {
+              // A held end moves only across its normal: its weight along the edge is w (1 −
+              // (n·d)²). An edge whose ends are both held along it (weight ≈ 0) cannot be
+              // corrected without pushing into a surface and is left to the collisions.
+              const Vec3 direction = delta / length;
+              const Real alongA = contactNormals[edge.a].dot(direction);
+              const Real alongB = contactNormals[edge.b].dot(direction);
+              const Real held = inverseMasses[edge.a] * (1 - alongA * alongA) +
+                                inverseMasses[edge.b] * (1 - alongB * alongB);
+              weightSum = held > kSmallestHeldWeight * weightSum ? held : 0;
+            }
             if (!(length > longest) || weightSum == 0) {
               m_overLimit[e] = 0;
               continue;
@@ -82,6 +153,11 @@ StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
     report.edgesOverLimit = over;
     if (over == 0 || iteration == settings.maxIterations) break;
     report.iterations = iteration + 1;
+
+    if (settings.order == StrainLimitOrder::GaussSeidel) {
+      sweep(stretchFactor, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
+      continue;
+    }
 
     // 2. Per vertex: how many over-limit edges move it (none for a vertex that cannot move).
     tasks.parallelFor(vertexCount, kGrainVertices, [&](Index begin, Index end, int) {
@@ -116,6 +192,7 @@ StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
           }
         }
         shift *= inverseMasses[i];
+        if (inContact) shift -= contactNormals[i].dot(shift) * contactNormals[i];
         x[i] += shift;
         v[i] += inverseStep * shift;
       }

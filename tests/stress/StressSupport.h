@@ -11,8 +11,10 @@
 // "The material's limit" is ClothMaterial::strainLimit, which the engine's strain limiter
 // enforces after every solve (engine/src/StrainLimiting.h); cotton's is 0.10, the end of woven
 // cotton's low-strain regime (its 260 N/m is the slope there) and Provot's classic threshold.
-// The limiter runs before the collision passes, which keep the last word, so a frame can end
-// above the limit where a collider or a contact moved vertices after it: the monitor also
+// The limiter runs after the solve and again after the collision passes (collider contacts held
+// along their normals, a few rounds), but the collisions keep the last word, so a frame can
+// still end above the limit where a contact (a self-contact above all) moved vertices after the
+// last round: the monitor also
 // records the edges the limiter itself left over the limit (StepStats::strainLimitEdgesOver), to
 // tell the two apart. Scenes whose set-up forces more strain than that (random or collapsed
 // starts, a teleport) measure it once the forcing is over; each says from when. Scenes that
