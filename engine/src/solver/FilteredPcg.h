@@ -24,9 +24,11 @@
 //   Ã = S A S + (I − S) keeps it: with Ã = L̃ + D̃ + L̃ᵀ, M = (D̃ + L̃) D̃⁻¹ (D̃ + L̃)ᵀ, SPD, and on the
 //   free subspace exactly because Ã does not mix it with the constrained one. Order: multicolour
 //   (MulticolorOrdering), so each sweep runs colour after colour and a colour's vertices in
-//   parallel, bitwise the same for any thread count; the colouring is built once per pattern
-//   (BlockSparseMatrix::patternId()), so it is agnostic to how the system is indexed and rebuilt
-//   if the pattern changes. Cost: Eisenstat's trick (1981) — CG runs on Â = P_L⁻¹ Ã P_L⁻ᵀ
+//   parallel, bitwise the same for any thread count. The colours come from the system's owner
+//   (setRowColors(): a cloth colours its mesh once, so zero terms that are skipped and pins that
+//   are removed do not change the order, nor the answer), else from A's pattern; the ordering is
+//   built once per pattern (BlockSparseMatrix::patternId()) and colours, and rebuilt if either
+//   changes. Cost: Eisenstat's trick (1981) — CG runs on Â = P_L⁻¹ Ã P_L⁻ᵀ
 //   (P_L = D̃ + L̃) with D̃ as its preconditioner, which is the same Krylov method as PCG on Ã with
 //   M, and Â ĉ = t + P_L⁻¹(ĉ − D̃ t), t = P_L⁻ᵀ ĉ, costs one backward and one forward half-sweep,
 //   i.e. one SpMV of work, instead of an SpMV plus two triangular solves. Δv is updated with t
@@ -71,6 +73,7 @@
 #include <weft/engine/SolverSettings.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -129,6 +132,11 @@ class FilteredPcg {
   SolveReport solve(const BlockSparseMatrix& A, const Vec3Array& b, const VertexFilter& filter,
                     const PcgSettings& settings, Vec3Array& deltaV, TaskSystem* tasks = nullptr);
 
+  /// Colours of A's rows for the Gauss–Seidel order (MulticolorOrdering::build), used by every
+  /// later solve while they separate every coupled pair of A's pattern (else the pattern is
+  /// coloured); empty: colour the pattern. The span must stay valid until the next call.
+  void setRowColors(std::span<const Index> rowColors) { m_rowColors = rowColors; }
+
   /// z = P̃⁻¹ r: the preconditioner `kind` built from A and filter exactly as solve() builds it
   /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r). r should lie in the free subspace
   /// (S r = r); z does, exactly zero at fixed vertices. For tests and diagnostics; sizes as solve().
@@ -162,8 +170,8 @@ class FilteredPcg {
   /// t = P_U⁻¹ c and w = c − D̃ t, colours in reverse.
   void backwardSweep(const VertexFilter& filter, const Vec3Array& c, Vec3Array& t, Vec3Array& w);
 
-  /// Colours A's pattern if it is new (allocates then) and packs its off-diagonal blocks in sweep
-  /// order (every solve: the values change).
+  /// Orders A's rows (m_rowColors, else A's pattern) if the pattern or colours are new (allocates
+  /// then) and packs its off-diagonal blocks in sweep order (every solve: the values change).
   void prepareGaussSeidel(const BlockSparseMatrix& A);
 
   /// The stopping rule of one solve (header, "Stopping").
@@ -196,6 +204,7 @@ class FilteredPcg {
   std::vector<Mat3> m_lowerBlocks;      ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
   std::vector<Mat3> m_upperBlocks;      ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
+  std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
 };
 
 }  // namespace weft
