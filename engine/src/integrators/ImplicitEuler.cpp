@@ -45,6 +45,7 @@ void ImplicitEuler::resizeRows(Index rowCount) {
 }
 
 void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
+  m_pcg.setRowColors(system.rowColors());  // the Gauss–Seidel order: the system's, not the pattern's
   PcgSettings pcgSettings;
   pcgSettings.tolerance = m_settings.cgTolerance;
   pcgSettings.maxIterations = m_settings.cgMaxIterations;
@@ -52,7 +53,6 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   pcgSettings.preconditioner = m_settings.preconditioner;
   WEFT_PROFILE_ZONE("solve");
   const std::int64_t start = FrameClock::nowNs();
-  m_pcg.setRowColors(system.rowColors());
   const SolveReport solve = m_pcg.solve(system.systemMatrix(), m_rowRightHandSide, m_filter,
                                         pcgSettings, m_correction, system.taskSystem());
   report.solveMs += FrameClock::msSince(start);

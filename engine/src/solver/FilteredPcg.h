@@ -18,7 +18,7 @@
 //   on both sides: D̃_i⁻¹ = S_i (S_i A_ii S_i + I − S_i)⁻¹ S_i, the exact inverse of A_ii on the
 //   vertex's free subspace and zero on the constrained one (zero for fixed vertices). Filtering
 //   keeps s = D̃⁻¹r in the free subspace, so the residual norm below sees free directions only.
-// - Gauss–Seidel (PreconditionerKind::MulticolorGaussSeidel, opt-in; SolverSettings says why). Block Jacobi ignores
+// - Gauss–Seidel (PreconditionerKind::MulticolorGaussSeidel, the engine default). Block Jacobi ignores
 //   the coupling between vertices, which dominates the mass on stiff cloth (iterations grow with
 //   stiffness until the cap). Symmetric Gauss–Seidel (SSOR, ω = 1) on the filtered matrix
 //   Ã = S A S + (I − S) keeps it: with Ã = L̃ + D̃ + L̃ᵀ, M = (D̃ + L̃) D̃⁻¹ (D̃ + L̃)ᵀ, SPD, and on the
@@ -200,11 +200,11 @@ class FilteredPcg {
   Vec3Array m_backward;          ///< t = P_U⁻¹ ĉ (Gauss–Seidel only)
   std::vector<Mat3> m_inverseDiagonal;  ///< D̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
-  MulticolorOrdering m_ordering;        ///< colouring of A's pattern (Gauss–Seidel only)
+  std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
+  MulticolorOrdering m_ordering;        ///< order of A's rows (Gauss–Seidel only)
   std::vector<Mat3> m_lowerBlocks;      ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
   std::vector<Mat3> m_upperBlocks;      ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
-  std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
 };
 
 }  // namespace weft
