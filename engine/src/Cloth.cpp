@@ -1,4 +1,5 @@
 #include "Cloth.h"
+#include "solver/MulticolorOrdering.h"
 
 #include <weft/threading/Profiler.h>
 
@@ -277,6 +278,13 @@ void Cloth::buildSystemRows() {
     if (rowA != kInvalidIndex && rowB != kInvalidIndex) rowPairs.push_back({rowA, rowB});
   }
   m_matrix.build(m_freeVertexMap.rowCount(), rowPairs);
+  if (m_vertexColors.size() != n) {
+    m_vertexColors = MulticolorOrdering::colorVertices(n, m_forces.potentialCoupledPairs());
+  }
+  m_rowColors.resize(m_freeVertexMap.rowCount());
+  for (Index row = 0; row < m_freeVertexMap.rowCount(); ++row) {
+    m_rowColors[row] = m_vertexColors[m_freeVertexMap.vertex(row)];
+  }
   m_pinnedCoupling.build(m_freeVertexMap, pairs);
   m_forces.bindMatrix(m_matrix, m_freeVertexMap, m_pinnedCoupling);
   m_contactFilter.resize(m_freeVertexMap.isIdentity() ? 0 : n);

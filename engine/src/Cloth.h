@@ -71,6 +71,7 @@ class Cloth final : public DynamicSystem {
   void subtractPrescribedCoupling(const Vec3Array& deltaV, Vec3Array& rows) const override {
     m_pinnedCoupling.subtractProduct(deltaV, rows);
   }
+  std::span<const Index> rowColors() const override { return m_rowColors; }
   std::span<const Index> prescribedVertices() const override { return m_pinnedSorted; }
   void applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const override;
   TaskSystem* taskSystem() override { return m_tasks; }
@@ -187,6 +188,9 @@ class Cloth final : public DynamicSystem {
   // removePinnedVertices) or every vertex; built with the pin set, at creation.
   FreeVertexMap m_freeVertexMap;
   PinnedCoupling m_pinnedCoupling;    // A(free row, pinned vertex), assembled with m_matrix
+  // Gauss–Seidel colours: of every vertex, from ClothForces::potentialCoupledPairs() at creation
+  // (so zero terms and removed pins leave the solve's order alone), and of m_matrix's rows.
+  std::vector<Index> m_vertexColors, m_rowColors;
   // Contacts gathered by vertex, renumbered into the solve's rows when pins are removed.
   VertexFilter m_contactFilter;
   std::vector<Index> m_contactRows;   // rows constrained in the solve's filter last step

@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cstdint>
+#include <span>
 
 namespace weft {
 
@@ -212,6 +213,34 @@ std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
     for (Index k = m_bendingRowOffsets[row]; k < m_bendingRowOffsets[row + 1]; ++k) {
       if (m_bendingEntries[k].column > row) pairs.push_back({row, m_bendingEntries[k].column});
     }
+  }
+  return pairs;
+}
+
+std::vector<std::array<Index, 2>> ClothForces::potentialCoupledPairs() const {
+  std::vector<std::array<Index, 2>> pairs;
+  auto addAll = [&pairs](std::span<const Index> vertices) {
+    for (std::size_t a = 0; a < vertices.size(); ++a)
+      for (std::size_t b = a + 1; b < vertices.size(); ++b) pairs.push_back({vertices[a], vertices[b]});
+  };
+  const ClothModel& model = *m_model;
+  if (m_settings.model == ForceModel::BaraffWitkin) {
+    for (const TriangleRest& triangle : model.triangles()) addAll(triangle.vertices);
+    if (m_settings.material.bendingModel == BendingModel::Isometric) {
+      // K̂ couples every two vertices of a stencil (buildIsometricBending).
+      std::vector<Index> stencilVertices;
+      for (const BendingStencil& stencil : model.bendingStencils()) {
+        stencilVertices.clear();
+        for (Index a = 0; a < stencil.weightCount; ++a) {
+          stencilVertices.push_back(model.bendingWeights()[stencil.firstWeight + a].vertex);
+        }
+        addAll(stencilVertices);
+      }
+    } else {
+      for (const Hinge& hinge : model.hinges()) addAll(hinge.vertices);
+    }
+  } else {
+    for (const Spring& spring : model.springs()) addAll(spring.vertices);
   }
   return pairs;
 }

@@ -64,6 +64,11 @@ class ClothForces {
 
   /// Vertex pairs that some element couples: the sparsity pattern of the system matrix.
   std::vector<std::array<Index, 2>> coupledPairs() const;
+  /// Vertex pairs that some force term of this model could couple whatever its coefficients
+  /// (also terms left out because they are zero, ClothForceSettings::skipZeroTerms): a superset
+  /// of coupledPairs() fixed by the mesh and the force and bending models, for the solver's
+  /// colouring (MulticolorOrdering), which then does not depend on which terms are zero.
+  std::vector<std::array<Index, 2>> potentialCoupledPairs() const;
   /// Looks up, once, the matrix slot of every block every element writes (row i = vertex i).
   void bindMatrix(const BlockSparseMatrix& matrix);
   /// The same with vertices removed from the system (FreeVertexMap.h): `matrix` has

@@ -51,6 +51,12 @@ class DynamicSystem {
     (void)deltaV, (void)rows;
   }
 
+  /// Colours of systemMatrix()'s rows for the Gauss–Seidel preconditioner's order
+  /// (FilteredPcg::setRowColors): fixed by the system's topology, not by which of its couplings
+  /// are assembled or which vertices are rows, so neither changes the solve's bits. Empty: the
+  /// solver colours the matrix pattern.
+  virtual std::span<const Index> rowColors() const { return {}; }
+
   /// Vertices whose motion is prescribed (pinned), in increasing order.
   virtual std::span<const Index> prescribedVertices() const = 0;
   /// Writes the prescribed position (m) and velocity (m/s) at time t into x and v for every

@@ -45,6 +45,7 @@ void ImplicitEuler::resizeRows(Index rowCount) {
 }
 
 void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
+  m_pcg.setRowColors(system.rowColors());  // the Gauss–Seidel order: the system's, not the pattern's
   PcgSettings pcgSettings;
   pcgSettings.tolerance = m_settings.cgTolerance;
   pcgSettings.maxIterations = m_settings.cgMaxIterations;

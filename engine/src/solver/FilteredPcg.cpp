@@ -326,9 +326,10 @@ Real FilteredPcg::sumInRange(Index count, Kernel&& kernel) {
 }
 
 void FilteredPcg::prepareGaussSeidel(const BlockSparseMatrix& A) {
-  if (!m_ordering.matches(A)) {
-    // A new pattern (set-up, or a topology change): colour it, size the packed blocks. Allocates.
-    m_ordering.build(A);
+  if (!m_ordering.matches(A, m_rowColors)) {
+    // A new pattern or colouring (set-up, or a topology change): order it, size the packed
+    // blocks. Allocates.
+    m_ordering.build(A, m_rowColors);
     m_lowerBlocks.resize(m_ordering.lowerSlots().size());
     m_upperBlocks.resize(m_ordering.upperSlots().size());
   }

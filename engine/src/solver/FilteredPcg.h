@@ -18,15 +18,17 @@
 //   on both sides: D̃_i⁻¹ = S_i (S_i A_ii S_i + I − S_i)⁻¹ S_i, the exact inverse of A_ii on the
 //   vertex's free subspace and zero on the constrained one (zero for fixed vertices). Filtering
 //   keeps s = D̃⁻¹r in the free subspace, so the residual norm below sees free directions only.
-// - Gauss–Seidel (PreconditionerKind::MulticolorGaussSeidel, opt-in; SolverSettings says why). Block Jacobi ignores
+// - Gauss–Seidel (PreconditionerKind::MulticolorGaussSeidel, the engine default). Block Jacobi ignores
 //   the coupling between vertices, which dominates the mass on stiff cloth (iterations grow with
 //   stiffness until the cap). Symmetric Gauss–Seidel (SSOR, ω = 1) on the filtered matrix
 //   Ã = S A S + (I − S) keeps it: with Ã = L̃ + D̃ + L̃ᵀ, M = (D̃ + L̃) D̃⁻¹ (D̃ + L̃)ᵀ, SPD, and on the
 //   free subspace exactly because Ã does not mix it with the constrained one. Order: multicolour
 //   (MulticolorOrdering), so each sweep runs colour after colour and a colour's vertices in
-//   parallel, bitwise the same for any thread count; the colouring is built once per pattern
-//   (BlockSparseMatrix::patternId()), so it is agnostic to how the system is indexed and rebuilt
-//   if the pattern changes. Cost: Eisenstat's trick (1981) — CG runs on Â = P_L⁻¹ Ã P_L⁻ᵀ
+//   parallel, bitwise the same for any thread count. The colours come from the system's owner
+//   (setRowColors(): a cloth colours its mesh once, so zero terms that are skipped and pins that
+//   are removed do not change the order, nor the answer), else from A's pattern; the ordering is
+//   built once per pattern (BlockSparseMatrix::patternId()) and colours, and rebuilt if either
+//   changes. Cost: Eisenstat's trick (1981) — CG runs on Â = P_L⁻¹ Ã P_L⁻ᵀ
 //   (P_L = D̃ + L̃) with D̃ as its preconditioner, which is the same Krylov method as PCG on Ã with
 //   M, and Â ĉ = t + P_L⁻¹(ĉ − D̃ t), t = P_L⁻ᵀ ĉ, costs one backward and one forward half-sweep,
 //   i.e. one SpMV of work, instead of an SpMV plus two triangular solves. Δv is updated with t
@@ -71,6 +73,7 @@
 #include <weft/engine/SolverSettings.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -129,6 +132,11 @@ class FilteredPcg {
   SolveReport solve(const BlockSparseMatrix& A, const Vec3Array& b, const VertexFilter& filter,
                     const PcgSettings& settings, Vec3Array& deltaV, TaskSystem* tasks = nullptr);
 
+  /// Colours of A's rows for the Gauss–Seidel order (MulticolorOrdering::build), used by every
+  /// later solve while they separate every coupled pair of A's pattern (else the pattern is
+  /// coloured); empty: colour the pattern. The span must stay valid until the next call.
+  void setRowColors(std::span<const Index> rowColors) { m_rowColors = rowColors; }
+
   /// z = P̃⁻¹ r: the preconditioner `kind` built from A and filter exactly as solve() builds it
   /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r). r should lie in the free subspace
   /// (S r = r); z does, exactly zero at fixed vertices. For tests and diagnostics; sizes as solve().
@@ -162,8 +170,8 @@ class FilteredPcg {
   /// t = P_U⁻¹ c and w = c − D̃ t, colours in reverse.
   void backwardSweep(const VertexFilter& filter, const Vec3Array& c, Vec3Array& t, Vec3Array& w);
 
-  /// Colours A's pattern if it is new (allocates then) and packs its off-diagonal blocks in sweep
-  /// order (every solve: the values change).
+  /// Orders A's rows (m_rowColors, else A's pattern) if the pattern or colours are new (allocates
+  /// then) and packs its off-diagonal blocks in sweep order (every solve: the values change).
   void prepareGaussSeidel(const BlockSparseMatrix& A);
 
   /// The stopping rule of one solve (header, "Stopping").
@@ -192,7 +200,8 @@ class FilteredPcg {
   Vec3Array m_backward;          ///< t = P_U⁻¹ ĉ (Gauss–Seidel only)
   std::vector<Mat3> m_inverseDiagonal;  ///< D̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
-  MulticolorOrdering m_ordering;        ///< colouring of A's pattern (Gauss–Seidel only)
+  std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
+  MulticolorOrdering m_ordering;        ///< order of A's rows (Gauss–Seidel only)
   std::vector<Mat3> m_lowerBlocks;      ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
   std::vector<Mat3> m_upperBlocks;      ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)

@@ -9,27 +9,41 @@
 //   colour after colour is then Gauss–Seidel in the order "colour 0, colour 1, …", vertex order
 //   inside a colour, whatever the thread count.
 // - How. Greedy colouring in vertex order: each vertex takes the smallest colour none of its
-//   already coloured neighbours has. Deterministic (depends only on the pattern), one pass over the
-//   stored blocks, and at most (largest row degree + 1) colours. On the cloth grids (1-ring
-//   stretch/shear plus the isometric-bending 2-ring) it gives 8–9 colours. Rejected: colourings
-//   that balance colour sizes or minimise the count (a few more vertices per colour change nothing
-//   at these sizes) and randomised (Jones–Plassmann) colourings, whose result depends on a seed.
+//   already coloured neighbours has. Deterministic (depends only on the graph), one pass over the
+//   pairs, and at most (largest degree + 1) colours. On the cloth grids (1-ring stretch/shear plus
+//   the isometric-bending 2-ring) it gives 8–9 colours. Rejected: colourings that balance colour
+//   sizes or minimise the count (a few more vertices per colour change nothing at these sizes)
+//   and randomised (Jones–Plassmann) colourings, whose result depends on a seed.
+// - Which graph. The order changes the preconditioner, so the iterates, so the bits of the
+//   answer (within the solve tolerance). Colouring the assembled pattern would make the answer
+//   depend on which force terms are structurally present (a cloth that skips its zero bending
+//   assembles no 2-ring: fewer colours, another order) and on which vertices are rows (removing
+//   pins renumbers and prunes the graph). So the owner of the system colours its vertices once,
+//   from every pair its force terms could couple whatever their coefficients (colorVertices), and
+//   passes the colours of its rows (`rowColors`): a cloth then sweeps in the same order with or
+//   without zero terms, with pins removed or filtered, and the skipped or removed couplings are
+//   exactly the zero blocks they would have been. A colouring that does not separate every
+//   coupled pair of the pattern (or none given: tests, other systems) falls back to colouring the
+//   pattern itself, so the sweeps are always correct; usesGivenColors() tells which was used.
+//   Colours no row has (say, held only by removed pins) are dropped, keeping their order.
 // - What is stored. The vertices of each colour, ascending, one colour after another (`order`,
 //   `colorOffsets`), and for every row the slots of its blocks split by colour: `lower` slots
 //   (column of a smaller colour: the "L" part the forward sweep reads) and `upper` slots (larger
 //   colour: the "U" part of the backward sweep), listed in sweep order with their columns. The
 //   diagonal is in neither. FilteredPcg copies the blocks of these slots once per solve into
 //   arrays in the same order, so every sweep streams through memory front to back.
-// - The ordering depends on the pattern only, not on the values: build it once per topology
-//   (BlockSparseMatrix::patternId() tells when the pattern changed) and reuse it every step.
-//   Nothing here depends on how the system is indexed or which vertices it contains.
+// - The ordering depends on the pattern and the given colours only, not on the values: build it
+//   once per topology (BlockSparseMatrix::patternId() tells when the pattern changed) and reuse it
+//   every step.
 #pragma once
 
 #include <solver/BlockSparseMatrix.h>
 
 #include <weft/Math.h>
 
+#include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -37,13 +51,23 @@ namespace weft {
 /// Colour classes of a block pattern plus the per-row split of its off-diagonal slots.
 class MulticolorOrdering {
  public:
-  /// Colours `matrix`'s pattern (values are not read). Allocates; call once per pattern.
-  void build(const BlockSparseMatrix& matrix);
+  /// Greedy colouring, in vertex order, of the graph on vertexCount vertices whose edges are
+  /// `pairs` (duplicates and (i, i) allowed; every index < vertexCount). Coupled vertices get
+  /// different colours. Allocates; for set-up time.
+  static std::vector<Index> colorVertices(Index vertexCount,
+                                          std::span<const std::array<Index, 2>> pairs);
 
-  /// True when built from a matrix with this pattern id (BlockSparseMatrix::patternId()).
-  bool matches(const BlockSparseMatrix& matrix) const {
-    return m_patternId == matrix.patternId() && m_patternId != 0;
-  }
+  /// Orders `matrix`'s rows (values are not read): by rowColors (one colour per row, e.g. from
+  /// colorVertices() on a supergraph of the pattern) when they separate every coupled pair of
+  /// the pattern, else by a greedy colouring of the pattern itself. Allocates; once per pattern.
+  void build(const BlockSparseMatrix& matrix, std::span<const Index> rowColors = {});
+
+  /// True when built from a matrix with this pattern id (BlockSparseMatrix::patternId()) and
+  /// these row colours (compared entry by entry: O(rows), no allocation).
+  bool matches(const BlockSparseMatrix& matrix, std::span<const Index> rowColors = {}) const;
+
+  /// True when the last build() used the given row colours (false: it coloured the pattern).
+  bool usesGivenColors() const { return m_usesGivenColors; }
 
   /// Number of colours (0 for an empty pattern).
   Index colorCount() const { return static_cast<Index>(m_colorOffsets.size()) - 1; }
@@ -75,6 +99,8 @@ class MulticolorOrdering {
 
  private:
   std::uint64_t m_patternId = 0;     ///< pattern this was built from; 0 = never built
+  std::vector<Index> m_givenColors;   ///< rowColors of the last build(), as given
+  bool m_usesGivenColors = false;     ///< m_colors are m_givenColors (compacted), not greedy
   std::vector<Index> m_colors;        ///< colour per vertex
   std::vector<Index> m_order;         ///< vertices sorted by (colour, index)
   std::vector<Index> m_colorOffsets;  ///< colorCount + 1 entries into m_order
