@@ -23,6 +23,9 @@ struct ErrorTimeOptions {
   Real referenceCgTolerance = 1e-10;  ///< PCG relative residual of the reference
   int repeats = 1;                ///< runs per configuration; the fastest wall time is kept
   bool progress = true;           ///< one line per run while sweeping
+  /// Runs only the configurations whose description contains this text (e.g. "h=1/60 "), and
+  /// always SolverSettings{}; empty = every configuration of the grid.
+  std::string only;
 };
 
 /// Runs the sweep, prints the Pareto front and where SolverSettings{} sits; 0 on success.

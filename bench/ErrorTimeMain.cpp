@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
   app.add_option("--repeat", options.repeats,
                  "Runs per configuration; the fastest wall time is kept (errors are identical)")
       ->check(CLI::Range(1, 20));
+  app.add_option("--only", options.only,
+                 "Run only the configurations whose description contains this text (the defaults "
+                 "always run), e.g. \"implicit-euler h=1/60 \"");
   bool quiet = false;
   app.add_flag("--quiet", quiet, "No line per run");
   CLI11_PARSE(app, argc, argv);

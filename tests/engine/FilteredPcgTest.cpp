@@ -482,6 +482,47 @@ TEST_P(FilteredPcgTest, VanishingRightHandSideStopsAtTheAbsoluteFloor) {
   EXPECT_LE(report.relativeResidual, 1);
 }
 
+// The velocity-error test (PcgStopping::VelocityError): the mass-weighted error of the answer,
+// against the exact solution, is within the tolerance of the velocity change (the window estimate
+// may stop a little early, hence the factor 3); masses of the wrong size are reported.
+TEST_P(FilteredPcgTest, VelocityErrorTestBoundsTheMassWeightedError) {
+  const RandomSystem system = makeRandomSystem(600, 12);
+  VertexFilter filter;
+  filter.resize(600);
+  filter.setFixed(10, Vec3(0.1, 0, 0));
+  const std::vector<Real> masses(600, 0.5);  // A ≥ 0.5 I: makeRandomSystem's masses are 0.5–1.5
+  Vec3Array exact;
+  FilteredPcg pcg;
+  ASSERT_TRUE(pcg.solve(system.A, system.b, filter, tightSettings(GetParam()), exact).converged);
+  Real exactNorm = 0;
+  for (Index i = 0; i < 600; ++i) exactNorm += masses[i] * exact[i].squaredNorm();
+  exactNorm = std::sqrt(exactNorm);
+  for (Real tolerance : {1e-2, 1e-4}) {
+    PcgSettings settings = settingsFor(GetParam());
+    settings.stopping = PcgStopping::VelocityError;
+    settings.tolerance = tolerance;
+    settings.maxIterations = 1000;
+    settings.warmStart = false;
+    Vec3Array deltaV;
+    const SolveReport report = pcg.solve(system.A, system.b, filter, settings, deltaV, nullptr, masses);
+    ASSERT_TRUE(report.converged) << "tolerance " << tolerance;
+    EXPECT_GT(report.iterations, 1);
+    EXPECT_LE(report.relativeResidual, tolerance);
+    Real error = 0;
+    for (Index i = 0; i < 600; ++i) error += masses[i] * (deltaV[i] - exact[i]).squaredNorm();
+    EXPECT_LE(std::sqrt(error), 3 * tolerance * exactNorm) << "tolerance " << tolerance;
+    EXPECT_EQ(deltaV[10], Vec3(0.1, 0, 0));
+  }
+  PcgSettings settings = settingsFor(GetParam());
+  settings.stopping = PcgStopping::VelocityError;
+  Vec3Array untouched(600, Vec3::Ones());
+  const std::vector<Real> tooFew(599, 0.5);
+  const SolveReport bad = pcg.solve(system.A, system.b, filter, settings, untouched, nullptr, tooFew);
+  EXPECT_FALSE(bad.converged);
+  EXPECT_TRUE(std::isnan(bad.relativeResidual));
+  EXPECT_EQ(untouched[0], Vec3::Ones());
+}
+
 TEST_P(FilteredPcgTest, RepeatedSolvesGiveTheSameBits) {
   const RandomSystem system = makeRandomSystem(900, 10);
   VertexFilter filter;

@@ -42,6 +42,7 @@ void ImplicitEuler::resizeRows(Index rowCount) {
   m_filteredRows.clear();
   m_correction.assign(rowCount, Vec3::Zero());
   m_rowRightHandSide.assign(rowCount, Vec3::Zero());
+  m_rowMass.assign(rowCount, 0);
 }
 
 void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
@@ -51,10 +52,12 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   pcgSettings.maxIterations = m_settings.cgMaxIterations;
   pcgSettings.warmStart = true;  // the caller prepares the initial guess in m_correction
   pcgSettings.preconditioner = m_settings.preconditioner;
+  // The stopping test (SolverSettings::cgStopping); the velocity-error one weighs by the masses.
+  pcgSettings.stopping = m_settings.cgStopping;
   WEFT_PROFILE_ZONE("solve");
   const std::int64_t start = FrameClock::nowNs();
   const SolveReport solve = m_pcg.solve(system.systemMatrix(), m_rowRightHandSide, m_filter,
-                                        pcgSettings, m_correction, system.taskSystem());
+                                        pcgSettings, m_correction, system.taskSystem(), m_rowMass);
   report.solveMs += FrameClock::msSince(start);
   ++report.linearSolves;
   report.cgIterations += solve.iterations;
@@ -73,6 +76,7 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   const Index rows = map.rowCount();
   resizeRows(rows);
   const std::vector<Real>& masses = system.masses();
+  for (Index row = 0; row < rows; ++row) m_rowMass[row] = masses[map.vertex(row)];
 
   // Pins: the velocity change that puts each pinned vertex exactly on its target at t + h. A pin
   // with a row is fixed in the filter; a removed one keeps its Δv in m_deltaV, where the

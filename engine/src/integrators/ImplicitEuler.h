@@ -55,6 +55,7 @@ class ImplicitEuler final : public Integrator {
   FreeVertexMap m_identityMap;            // for systems that remove nothing (freeVertexMap() null)
   Vec3Array m_deltaV;            // Δv of this step by vertex; the previous one is the warm start
   Vec3Array m_correction;        // by row: the solve's unknown (Δv, or δ of a Newton iteration)
+  std::vector<Real> m_rowMass;   // by row: the vertex masses (kg), for the PCG's stopping norm
   Vec3Array m_rowRightHandSide;  // by row: b gathered, minus the removed pins' coupling
   Vec3Array m_force;             // f at the expansion point
   Vec3Array m_stiffnessTimesVelocity;

@@ -11,6 +11,20 @@ namespace weft {
 
 namespace {
 
+using PassSums = FilteredPcgPassSums;
+
+using MassWeights = FilteredPcgMassWeights;
+
+/// One vertex's term of the stopping norm²: rᵀM⁻¹r for the velocity test, rᵀs = rᵀD̃⁻¹r otherwise.
+inline Real stopTerm(const MassWeights& weights, Index vertex, const Vec3& r, const Vec3& s) {
+  return weights.active() ? weights.inverseMass[vertex] * r.squaredNorm() : r.dot(s);
+}
+
+/// One vertex's term of ‖Δv‖²_M (zero for the relative-residual test).
+inline Real massTerm(const MassWeights& weights, Index vertex, const Vec3& deltaV) {
+  return weights.active() ? weights.mass[vertex] * deltaV.squaredNorm() : Real(0);
+}
+
 // --- Kernels over a vertex range [begin, end). Each touches only its own vertices' entries of the
 // --- output arrays (reading neighbours only through the SpMV gather), and each dot product is
 // --- summed in vertex order, so a range gives the same bits whichever thread runs it.
@@ -74,27 +88,31 @@ Real targetRange(Index begin, Index end, const VertexFilter& filter, Vec3Array& 
   return sum;
 }
 
-/// r = S b, s = P̃⁻¹ r over the range; returns Σ rᵀs (the residual of a zero start).
-Real rightHandSideRange(Index begin, Index end, const Vec3Array& b, const VertexFilter& filter,
-                        const std::vector<Mat3>& inverseDiagonal, Vec3Array& r, Vec3Array& s) {
-  Real sum = 0;
+/// r = S b, s = P̃⁻¹ r over the range; returns Σ rᵀs and the stopping norm² (of a zero start).
+PassSums rightHandSideRange(Index begin, Index end, const Vec3Array& b, const VertexFilter& filter,
+                            const std::vector<Mat3>& inverseDiagonal, const MassWeights& weights,
+                            Vec3Array& r, Vec3Array& s) {
+  PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
     r[vertex] = filter.filter(vertex, b[vertex]);
     s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
-    sum += r[vertex].dot(s[vertex]);
+    sum.cg += r[vertex].dot(s[vertex]);
+    sum.stop += stopTerm(weights, vertex, r[vertex], s[vertex]);
   }
   return sum;
 }
 
-/// r = S(b − A x), s = P̃⁻¹ r over the range; returns Σ rᵀs.
-Real residualRange(Index begin, Index end, const BlockSparseMatrix& A, const Vec3Array& b,
-                   const VertexFilter& filter, const std::vector<Mat3>& inverseDiagonal,
-                   const Vec3Array& x, Vec3Array& r, Vec3Array& s) {
-  Real sum = 0;
+/// r = S(b − A x), s = P̃⁻¹ r over the range; returns Σ rᵀs, the stopping norm² and ‖x‖²_M.
+PassSums residualRange(Index begin, Index end, const BlockSparseMatrix& A, const Vec3Array& b,
+                       const VertexFilter& filter, const std::vector<Mat3>& inverseDiagonal,
+                       const MassWeights& weights, const Vec3Array& x, Vec3Array& r, Vec3Array& s) {
+  PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
     r[vertex] = filter.filter(vertex, b[vertex] - A.multiplyRow(vertex, x));
     s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
-    sum += r[vertex].dot(s[vertex]);
+    sum.cg += r[vertex].dot(s[vertex]);
+    sum.stop += stopTerm(weights, vertex, r[vertex], s[vertex]);
+    sum.scale += massTerm(weights, vertex, x[vertex]);
   }
   return sum;
 }
@@ -115,16 +133,30 @@ Real filteredProductRange(Index begin, Index end, const BlockSparseMatrix& A,
   return sum;
 }
 
-/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs.
-Real updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const Vec3Array& q,
-                 const std::vector<Mat3>& inverseDiagonal, Vec3Array& deltaV, Vec3Array& r,
-                 Vec3Array& s) {
-  Real sum = 0;
+/// ‖Δv − snapshot‖²_M over one vertex, then snapshot = Δv (the window's progress, header
+/// "Stopping"); nothing without a snapshot.
+inline Real progressTerm(const MassWeights& weights, Index vertex, const Vec3& deltaV,
+                         Vec3Array* snapshot) {
+  if (!snapshot) return 0;
+  const Real term = massTerm(weights, vertex, deltaV - (*snapshot)[vertex]);
+  (*snapshot)[vertex] = deltaV;
+  return term;
+}
+
+/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs, the stopping norm², ‖Δv‖²_M and,
+/// with a snapshot, the window's progress.
+PassSums updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const Vec3Array& q,
+                     const std::vector<Mat3>& inverseDiagonal, const MassWeights& weights,
+                     Vec3Array& deltaV, Vec3Array& r, Vec3Array& s, Vec3Array* snapshot) {
+  PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
     deltaV[vertex] += alpha * c[vertex];
     r[vertex] -= alpha * q[vertex];
     s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
-    sum += r[vertex].dot(s[vertex]);
+    sum.cg += r[vertex].dot(s[vertex]);
+    sum.stop += stopTerm(weights, vertex, r[vertex], s[vertex]);
+    sum.scale += massTerm(weights, vertex, deltaV[vertex]);
+    sum.progress += progressTerm(weights, vertex, deltaV[vertex], snapshot);
   }
   return sum;
 }
@@ -209,29 +241,34 @@ Real diagonalRange(Index begin, Index end, const BlockSparseMatrix& A, const Ver
   return sum;
 }
 
-/// Δv += α t, r̂ −= α (t + w), ŝ = D̃ r̂ over the range; returns Σ r̂ᵀŝ.
-Real transformedUpdateRange(Index begin, Index end, Real alpha, const BlockSparseMatrix& A,
-                            const VertexFilter& filter, const Vec3Array& t, const Vec3Array& w,
-                            Vec3Array& deltaV, Vec3Array& r, Vec3Array& s) {
-  Real sum = 0;
+/// Δv += α t, r̂ −= α (t + w), ŝ = D̃ r̂ over the range; returns Σ r̂ᵀŝ, ‖Δv‖²_M and, with a
+/// snapshot, the window's progress.
+PassSums transformedUpdateRange(Index begin, Index end, Real alpha, const BlockSparseMatrix& A,
+                                const VertexFilter& filter, const MassWeights& weights,
+                                const Vec3Array& t, const Vec3Array& w, Vec3Array& deltaV,
+                                Vec3Array& r, Vec3Array& s, Vec3Array* snapshot) {
+  PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
     deltaV[vertex] += alpha * t[vertex];
     r[vertex] -= alpha * (t[vertex] + w[vertex]);
     s[vertex] = filter.filter(vertex, A.block(A.diagonalSlot(vertex)) * r[vertex]);
-    sum += r[vertex].dot(s[vertex]);
+    sum.cg += r[vertex].dot(s[vertex]);
+    sum.scale += massTerm(weights, vertex, deltaV[vertex]);
+    sum.progress += progressTerm(weights, vertex, deltaV[vertex], snapshot);
   }
   return sum;
 }
 
 /// The true residual r = P_L r̂ = ŝ + S L̃ r̂ (ŝ = D̃ r̂) over sweep positions [begin, end); returns
-/// Σ rᵀD̃⁻¹r, the stopping norm². Positions are independent: any split gives the same bits.
-Real untransformedNormRange(Index begin, Index end, const PackedBlocks& blocks,
+/// Σ rᵀD̃⁻¹r (cg) and the stopping norm² (stop: the same, or Σ rᵀM⁻¹r for the velocity test).
+/// Positions are independent: any split gives the same bits.
+PassSums untransformedNormRange(Index begin, Index end, const PackedBlocks& blocks,
                             const MulticolorOrdering& ordering, const VertexFilter& filter,
-                            const std::vector<Mat3>& inverseDiagonal, const Vec3Array& r,
-                            const Vec3Array& s) {
+                            const std::vector<Mat3>& inverseDiagonal,
+                            const MassWeights& weights, const Vec3Array& r, const Vec3Array& s) {
   const Index* columns = ordering.lowerColumns().data();
   const Mat3* lower = blocks.lower.data();
-  Real sum = 0;
+  PassSums sum;
   for (Index k = begin; k < end; ++k) {
     const Index vertex = ordering.order()[k];
     Vec3 product = Vec3::Zero();
@@ -239,7 +276,9 @@ Real untransformedNormRange(Index begin, Index end, const PackedBlocks& blocks,
       product.noalias() += lower[e] * r[columns[e]];
     }
     const Vec3 residual = s[vertex] + filter.filter(vertex, product);
-    sum += residual.dot(inverseDiagonal[vertex] * residual);
+    sum.cg += residual.dot(inverseDiagonal[vertex] * residual);
+    sum.stop += weights.active() ? weights.inverseMass[vertex] * residual.squaredNorm()
+                                 : residual.dot(inverseDiagonal[vertex] * residual);
   }
   return sum;
 }
@@ -262,26 +301,27 @@ void FilteredPcg::resize(Index vertexCount) {
   m_product.assign(vertexCount, Vec3::Zero());
   m_backward.assign(vertexCount, Vec3::Zero());
   m_inverseDiagonal.assign(vertexCount, Mat3::Zero());
+  m_inverseMass.assign(vertexCount, 0);
+  m_stopMass.assign(vertexCount, 0);
+  m_snapshot.assign(vertexCount, Vec3::Zero());
   m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
 }
 
 template <typename Kernel>
-Real FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
-  const Index blockCount = (vertexCount + kReductionBlock - 1) / kReductionBlock;
+auto FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
+  using Sum = decltype(kernel(Index(0), Index(0)));
   if (m_tasks) {
     // Fixed blocks, partials combined in block order: the same bits as the loop below.
     return m_tasks->parallelReduce(
-        vertexCount, kReductionBlock, Real(0),
+        vertexCount, kReductionBlock, Sum{},
         [&](Index begin, Index end) { return kernel(begin, end); },
-        [](Real sum, Real partial) { return sum + partial; });
+        [](const Sum& sum, const Sum& partial) { return sum + partial; });
   }
-  for (Index block = 0; block < blockCount; ++block) {
-    const Index begin = block * kReductionBlock;
-    m_blockPartials[block] = kernel(begin, std::min(begin + kReductionBlock, vertexCount));
+  // Combine in block order, starting from zero: the one summation order, whatever the thread count.
+  Sum sum{};
+  for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
+    sum = sum + kernel(begin, std::min(begin + kReductionBlock, vertexCount));
   }
-  // Combine in block order: the one summation order, whatever the thread count.
-  Real sum = 0;
-  for (Index block = 0; block < blockCount; ++block) sum += m_blockPartials[block];
   return sum;
 }
 
@@ -391,12 +431,15 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
 
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
                                const VertexFilter& filter, const PcgSettings& settings,
-                               Vec3Array& deltaV, TaskSystem* tasks) {
+                               Vec3Array& deltaV, TaskSystem* tasks,
+                               std::span<const Real> masses) {
   SolveReport report;
   m_tasks = tasks;
   const Index vertexCount = A.blockRows();
+  const bool velocityTest = settings.stopping == PcgStopping::VelocityError;
   // Validated rather than asserted: the contract says a mismatch is reported, not undefined.
-  if (b.size() != vertexCount || filter.size() != vertexCount) {
+  if (b.size() != vertexCount || filter.size() != vertexCount ||
+      (velocityTest && masses.size() != std::size_t(vertexCount))) {
     report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
     report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
     return report;
@@ -419,68 +462,119 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   // The colouring depends on the pattern only: rebuilt (allocating) when the topology changes.
   if (gaussSeidel) prepareGaussSeidel(A);
 
-  // The reference r_ref = S(b − A(I − S)z). A cold start begins exactly there, so it is the initial
-  // residual; a warm start needs it separately, and needs the SpMV only when some target is nonzero.
+  // The velocity test's weights: m_i and 1/m_i on vertices with a free direction, zero on fixed
+  // ones (and on a massless row, which a valid system does not have). Σm is the mass that moves.
+  MassWeights weights;
+  Real movingMass = 0;
+  if (velocityTest) {
+    for (Index vertex = 0; vertex < vertexCount; ++vertex) {
+      const Real mass = masses[vertex];
+      const bool counts = filter.kind(vertex) != ConstraintKind::Fixed && mass > 0 && std::isfinite(mass);
+      m_stopMass[vertex] = counts ? mass : Real(0);
+      m_inverseMass[vertex] = counts ? 1 / mass : Real(0);
+      movingMass += m_stopMass[vertex];
+    }
+    weights = MassWeights{m_stopMass.data(), m_inverseMass.data()};
+  }
+
+  // The relative-residual test's reference r_ref = S(b − A(I − S)z). A cold start begins exactly
+  // there, so it is the initial residual; a warm start needs it separately, and needs the SpMV only
+  // when some target is nonzero. The velocity test needs no reference.
   Real referenceDelta = 0;
   if (warmStart) {
     const Real targetSquaredNorm = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
       return targetRange(begin, end, filter, c);
     });
     referenceDelta =
-        targetSquaredNorm == 0
-            ? sumOverBlocks(vertexCount,
-                            [&](Index begin, Index end) {
-                              return rightHandSideRange(begin, end, b, filter, m_inverseDiagonal,
-                                                        r, s);
-                            })
-            : sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-                return residualRange(begin, end, A, b, filter, m_inverseDiagonal, c, r, s);
-              });
+        (targetSquaredNorm == 0
+             ? sumOverBlocks(vertexCount,
+                             [&](Index begin, Index end) {
+                               return rightHandSideRange(begin, end, b, filter, m_inverseDiagonal,
+                                                         weights, r, s);
+                             })
+             : sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+                 return residualRange(begin, end, A, b, filter, m_inverseDiagonal, weights, c, r, s);
+               }))
+            .cg;
   }
 
   forEachBlock(vertexCount,
                [&](Index begin, Index end) { startRange(begin, end, filter, warmStart, deltaV); });
-  // stopDelta = rᵀD̃⁻¹r drives the stopping rule; delta = rᵀs = rᵀP⁻¹r drives CG. They are one
-  // number for block Jacobi (s = D̃⁻¹r).
-  Real stopDelta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-    return residualRange(begin, end, A, b, filter, m_inverseDiagonal, deltaV, r, s);
+  // start.stop drives the stopping rule; start.cg = rᵀs = rᵀP⁻¹r drives CG. They are one number
+  // for the relative-residual test with block Jacobi (s = D̃⁻¹r).
+  const PassSums start = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return residualRange(begin, end, A, b, filter, m_inverseDiagonal, weights, deltaV, r, s);
   });
-  if (!warmStart) referenceDelta = stopDelta;
+  if (!warmStart) referenceDelta = start.cg;
 
+  Stopping stopping;
+  stopping.velocityTest = velocityTest;
+  stopping.tolerance = settings.tolerance;
+  stopping.absoluteTolerance = settings.absoluteTolerance;
+  stopping.maxIterations = settings.maxIterations;
   // rᵀP̃⁻¹r ≥ 0 in exact arithmetic; clamp rounding below zero before the square root.
-  const Real referenceNorm = std::sqrt(std::max(referenceDelta, Real(0)));
-  const Stopping stopping{std::max(settings.tolerance * referenceNorm, settings.absoluteTolerance),
-                          std::max(referenceNorm, settings.absoluteTolerance),
-                          std::isfinite(referenceDelta), settings.maxIterations};
+  stopping.referenceNorm = std::sqrt(std::max(referenceDelta, Real(0)));
+  stopping.referenceFinite = std::isfinite(referenceDelta) && std::isfinite(movingMass);
+  if (velocityTest) {
+    stopping.scaleFloor = std::max(settings.velocityFloor, Real(0)) * std::sqrt(movingMass);
+    stopping.window = std::clamp(settings.progressWindow, 1, 1 << 20);
+  }
   if (gaussSeidel) {
-    iterateGaussSeidel(A, filter, stopping, stopDelta, deltaV, report);
+    iterateGaussSeidel(A, filter, weights, stopping, start, deltaV, report);
   } else {
-    iterateJacobi(A, filter, stopping, stopDelta, deltaV, report);
+    iterateJacobi(A, filter, weights, stopping, start, deltaV, report);
   }
   return report;
 }
 
-/// Fills the report's residual fields from the stopping norm² and says whether it converged.
-bool FilteredPcg::Stopping::judge(Real stopDelta, SolveReport& report) const {
+Real FilteredPcg::Stopping::scale(Real solutionSquaredNorm) const {
+  if (!velocityTest) return referenceNorm;
+  return std::max(std::sqrt(std::max(solutionSquaredNorm, Real(0))), scaleFloor);
+}
+
+Real FilteredPcg::Stopping::threshold(Real solutionSquaredNorm) const {
+  return std::max(tolerance * scale(solutionSquaredNorm), absoluteTolerance);
+}
+
+/// Fills the report's residual fields and says whether the solve has converged.
+bool FilteredPcg::Stopping::judge(Real stopDelta, Real residualDelta, Real solutionSquaredNorm,
+                                  Real progressSquared, SolveReport& report) const {
   // NaN compares false with everything, so test finiteness first: a NaN residual must end the
   // loop as a failure, never look converged and never spin until the cap.
-  if (!referenceFinite || !std::isfinite(stopDelta)) {
+  if (!referenceFinite || !std::isfinite(stopDelta) || !std::isfinite(residualDelta) ||
+      !std::isfinite(solutionSquaredNorm) || std::isnan(progressSquared)) {
     report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
     report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
     report.converged = false;
     return false;
   }
   report.residualNorm = std::sqrt(std::max(stopDelta, Real(0)));
-  // A zero denominator needs absoluteTolerance = 0 and a zero reference; avoid 0/0 there.
-  report.relativeResidual = denominator > 0 ? report.residualNorm / denominator
-                            : report.residualNorm == 0 ? Real(0)
-                                                       : std::numeric_limits<Real>::infinity();
-  report.converged = report.residualNorm <= threshold;
-  return report.converged;
+  const Real goal = threshold(solutionSquaredNorm);
+  Real error = report.residualNorm;
+  bool converged = error <= goal;
+  if (velocityTest && progressSquared >= 0) {
+    // The window's progress counts only where the block-Jacobi residual agrees (header,
+    // "Stopping"): each covers the other's blind spot.
+    const Real progress = std::sqrt(progressSquared);
+    const bool residualAgrees = std::sqrt(std::max(residualDelta, Real(0))) <=
+                                std::max(tolerance * referenceNorm, absoluteTolerance);
+    if (residualAgrees) {
+      error = std::min(error, progress);
+      converged = converged || progress <= goal;
+    }
+  }
+  const Real denominator = std::max(scale(solutionSquaredNorm), absoluteTolerance);
+  // A zero denominator needs absoluteTolerance = 0 and a zero scale; avoid 0/0 there.
+  report.relativeResidual = denominator > 0 ? error / denominator
+                            : error == 0   ? Real(0)
+                                           : std::numeric_limits<Real>::infinity();
+  report.converged = converged;
+  return converged;
 }
 
 void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& filter,
-                                const Stopping& stopping, Real delta, Vec3Array& deltaV,
+                                const FilteredPcgMassWeights& weights, const Stopping& stopping,
+                                const FilteredPcgPassSums& start, Vec3Array& deltaV,
                                 SolveReport& report) {
   const Index vertexCount = A.blockRows();
   Vec3Array& r = m_residual;
@@ -488,14 +582,27 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
   Vec3Array& c = m_direction;
   Vec3Array& q = m_product;
   forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
+  // The velocity test's progress window starts at the initial guess.
+  if (stopping.velocityTest) {
+    forEachBlock(vertexCount,
+                 [&](Index begin, Index end) { copyRange(begin, end, deltaV, m_snapshot); });
+  }
 
-  Real previousDelta = delta;
+  PassSums sums = start;
+  Real previousDelta = sums.cg;
   for (;;) {
-    if (stopping.judge(delta, report) || !std::isfinite(report.residualNorm)) break;
+    // The progress of the window that ended with the last update, if one did.
+    const bool windowEnded = stopping.velocityTest && report.iterations > 0 &&
+                             report.iterations % stopping.window == 0;
+    if (stopping.judge(sums.stop, sums.cg, sums.scale, windowEnded ? sums.progress : Real(-1),
+                       report) ||
+        !std::isfinite(report.residualNorm)) {
+      break;
+    }
     if (report.iterations >= stopping.maxIterations) break;
 
     if (report.iterations > 0) {
-      const Real beta = delta / previousDelta;
+      const Real beta = sums.cg / previousDelta;
       forEachBlock(vertexCount, [&](Index begin, Index end) {
         directionRange(begin, end, beta, filter, s, c);
       });
@@ -512,18 +619,23 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
       }
       break;
     }
-    const Real alpha = delta / curvature;
-    previousDelta = delta;
-    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, deltaV, r, s);
+    const Real alpha = sums.cg / curvature;
+    previousDelta = sums.cg;
+    Vec3Array* snapshot = stopping.velocityTest && (report.iterations + 1) % stopping.window == 0
+                              ? &m_snapshot
+                              : nullptr;
+    sums = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, weights, deltaV, r, s,
+                         snapshot);
     });
     ++report.iterations;
   }
 }
 
 void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
-                                     const Stopping& stopping, Real startStopDelta,
-                                     Vec3Array& deltaV, SolveReport& report) {
+                                     const FilteredPcgMassWeights& weights, const Stopping& stopping,
+                                     const FilteredPcgPassSums& start, Vec3Array& deltaV,
+                                     SolveReport& report) {
   const Index vertexCount = A.blockRows();
   Vec3Array& r = m_residual;        // r̂ = P_L⁻¹ r
   Vec3Array& s = m_preconditioned;  // ŝ = D̃ r̂
@@ -532,8 +644,16 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   Vec3Array& w = m_product;         // u, then w = P_L⁻¹ u; Â ĉ = t + w
 
   // The start's residual is exact (residualRange); a bad one ends the solve before any sweep.
-  if (stopping.judge(startStopDelta, report) || !std::isfinite(report.residualNorm)) return;
+  Real solutionSquaredNorm = start.scale;
+  if (stopping.judge(start.stop, start.cg, solutionSquaredNorm, -1, report) ||
+      !std::isfinite(report.residualNorm)) {
+    return;
+  }
   if (stopping.maxIterations <= 0) return;
+  if (stopping.velocityTest) {
+    forEachBlock(vertexCount,
+                 [&](Index begin, Index end) { copyRange(begin, end, deltaV, m_snapshot); });
+  }
 
   forwardSweep<false>(filter, c, t, r);  // r̂ = P_L⁻¹ r, in place
   Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
@@ -541,28 +661,39 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   });
   forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
   // ‖r‖²_{M⁻¹} = r̂ᵀD̃r̂ = delta (M the SGS preconditioner) falls with CG's iterations; its ratio to
-  // the start scales the start's exact ‖r‖_{D̃⁻¹} into an estimate, and the exact norm (one
+  // the start scales the start's exact stopping norm into an estimate, and the exact norm (one
   // half-SpMV) is computed only once the estimate is below the threshold.
   const Real startDelta = delta;
   const Real startNorm = report.residualNorm;
-  auto exactStopDelta = [&] {
+  auto exactNorms = [&] {
     return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return untransformedNormRange(begin, end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
-                                    m_inverseDiagonal, r, s);
+      return untransformedNormRange(begin, end, PackedBlocks{m_lowerBlocks, m_upperBlocks},
+                                    m_ordering, filter, m_inverseDiagonal, weights, r, s);
     });
   };
 
   Real previousDelta = delta;
+  Real progress = -1;  // the velocity test's window progress², when a window has just ended
   for (;;) {
     if (!std::isfinite(delta)) {
-      stopping.judge(std::numeric_limits<Real>::quiet_NaN(), report);
+      stopping.judge(std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::quiet_NaN(),
+                     solutionSquaredNorm, -1, report);
       break;
     }
     if (report.iterations > 0) {
+      // The velocity test's window progress is free (fused into the update); when it meets the
+      // threshold the solve ends without the exact residual's half-SpMV.
       const Real estimate =
           startDelta > 0 ? startNorm * std::sqrt(std::max(delta, Real(0)) / startDelta) : Real(0);
-      if (estimate <= stopping.threshold || report.iterations >= stopping.maxIterations) {
-        if (stopping.judge(exactStopDelta(), report) || !std::isfinite(report.residualNorm)) break;
+      const bool windowMet =
+          progress >= 0 && std::sqrt(progress) <= stopping.threshold(solutionSquaredNorm);
+      if (windowMet || estimate <= stopping.threshold(solutionSquaredNorm) ||
+          report.iterations >= stopping.maxIterations) {
+        const PassSums exact = exactNorms();
+        if (stopping.judge(exact.stop, exact.cg, solutionSquaredNorm, progress, report) ||
+            !std::isfinite(report.residualNorm)) {
+          break;
+        }
       }
       if (report.iterations >= stopping.maxIterations) break;
       const Real beta = delta / previousDelta;
@@ -575,16 +706,28 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
     // ĉᵀÂĉ ≤ 0: breakdown (A not positive definite on the free subspace, or a NaN). Δv keeps the
     // last finite iterate; the report gets that iterate's exact residual.
     if (!(curvature > 0) || !std::isfinite(curvature)) {
-      if (!std::isfinite(curvature)) stopping.judge(std::numeric_limits<Real>::quiet_NaN(), report);
-      else if (report.iterations > 0) stopping.judge(exactStopDelta(), report);
+      if (!std::isfinite(curvature)) {
+        stopping.judge(std::numeric_limits<Real>::quiet_NaN(), std::numeric_limits<Real>::quiet_NaN(),
+                     solutionSquaredNorm, -1, report);
+      } else if (report.iterations > 0) {
+        const PassSums exact = exactNorms();
+        stopping.judge(exact.stop, exact.cg, solutionSquaredNorm, -1, report);
+      }
       report.converged = false;
       break;
     }
     const Real alpha = delta / curvature;
     previousDelta = delta;
-    delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return transformedUpdateRange(begin, end, alpha, A, filter, t, w, deltaV, r, s);
+    Vec3Array* snapshot = stopping.velocityTest && (report.iterations + 1) % stopping.window == 0
+                              ? &m_snapshot
+                              : nullptr;
+    const PassSums sums = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+      return transformedUpdateRange(begin, end, alpha, A, filter, weights, t, w, deltaV, r, s,
+                                    snapshot);
     });
+    delta = sums.cg;
+    solutionSquaredNorm = sums.scale;
+    progress = snapshot ? sums.progress : Real(-1);
     ++report.iterations;
   }
 }
