@@ -291,6 +291,14 @@ std::vector<SweepConfig> sweepConfigs(const ErrorTimeOptions& options) {
           config.solver.cgTolerance = tolerance;
           config.solver.warmStart = warm;
           configs.push_back(config);
+          // The same step with the velocity-error stopping test (SolverSettings::cgStopping); in
+          // quick mode warm starts at the two coarsest steps only.
+          if (newton == 0 && warm && (!options.quick || n <= 2)) {
+            SweepConfig velocity = config;
+            velocity.method = "implicit-euler-verr";
+            velocity.solver.cgStopping = PcgStopping::VelocityError;
+            configs.push_back(velocity);
+          }
         }
       }
     }
