@@ -2,6 +2,7 @@
 // the kernel's held vertices and Gauss–Seidel order alone, then in a World, where a collider's
 // response and friction used to stretch the cloth after the limiter.
 #include "StrainLimiting.h"
+#include "ContactTestSupport.h"
 
 #include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
@@ -108,15 +109,6 @@ TEST(StrainLimitingInContact, GaussSeidelBringsAChainWithinTheLimitInFewerIterat
 
 constexpr Real kAllowed = 0.10 + 0.01;
 
-std::shared_ptr<const ClothModel> horizontalSheet(Index vertices, Real size, Real y) {
-  GridSettings grid;
-  grid.columns = grid.rows = vertices;
-  grid.width = grid.height = size;
-  grid.origin = Vec3(-size / 2, y, size / 2);
-  grid.widthAxis = Vec3(1, 0, 0);
-  grid.heightAxis = Vec3(0, 0, -1);
-  return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
-}
 
 struct SpinRun {
   Real maxStrain = 0;
@@ -142,7 +134,7 @@ SpinRun dropOnSpinningSphere(int threads) {
   settings.material = cottonFabric();
   settings.material.friction = 0.4;
   settings.selfCollision = false;  // the collider path alone, and a fast test
-  const ClothId cloth = world.createCloth(horizontalSheet(15, 0.7, 0.25), settings).value();
+  const ClothId cloth = world.createCloth(test::horizontalSquare(15, 0.7, 0.25), settings).value();
   SpinRun run;
   for (int frame = 0; frame < 90; ++frame) {
     world.step(kStep);
