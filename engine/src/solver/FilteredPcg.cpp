@@ -308,25 +308,25 @@ void FilteredPcg::resize(Index vertexCount) {
 }
 
 template <typename Kernel>
-auto FilteredPcg::sumOverBlocks(Index vertexCount, Kernel&& kernel) {
+auto FilteredPcg::sumOverBlocks(Index count, Kernel&& kernel) {
   using Sum = decltype(kernel(Index(0), Index(0)));
   if (m_tasks) {
     // Fixed blocks, partials combined in block order: the same bits as the loop below.
     return m_tasks->parallelReduce(
-        vertexCount, kReductionBlock, Sum{},
+        count, kReductionBlock, Sum{},
         [&](Index begin, Index end) { return kernel(begin, end); },
         [](const Sum& sum, const Sum& partial) { return sum + partial; });
   }
   // Combine in block order, starting from zero: the one summation order, whatever the thread count.
   Sum sum{};
-  for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
-    sum = sum + kernel(begin, std::min(begin + kReductionBlock, vertexCount));
+  for (Index begin = 0; begin < count; begin += kReductionBlock) {
+    sum = sum + kernel(begin, std::min(begin + kReductionBlock, count));
   }
   return sum;
 }
 
 template <typename Kernel>
-void FilteredPcg::forEachInRange(Index count, Kernel&& kernel) {
+void FilteredPcg::forEachBlock(Index count, Kernel&& kernel) {
   // parallelFor runs a single block inline (no fork): a colour smaller than a block costs nothing
   // in task overhead, which matters since a sweep visits every colour twice per iteration.
   if (m_tasks) {
@@ -337,32 +337,6 @@ void FilteredPcg::forEachInRange(Index count, Kernel&& kernel) {
   for (Index begin = 0; begin < count; begin += kReductionBlock) {
     kernel(begin, std::min(begin + kReductionBlock, count));
   }
-}
-
-template <typename Kernel>
-void FilteredPcg::forEachBlock(Index vertexCount, Kernel&& kernel) {
-  if (m_tasks) {
-    m_tasks->parallelFor(vertexCount, kReductionBlock,
-                         [&](Index begin, Index end, int) { kernel(begin, end); });
-    return;
-  }
-  for (Index begin = 0; begin < vertexCount; begin += kReductionBlock) {
-    kernel(begin, std::min(begin + kReductionBlock, vertexCount));
-  }
-}
-
-template <typename Kernel>
-Real FilteredPcg::sumInRange(Index count, Kernel&& kernel) {
-  if (m_tasks) {
-    return m_tasks->parallelReduce(
-        count, kReductionBlock, Real(0), [&](Index begin, Index end) { return kernel(begin, end); },
-        [](Real sum, Real partial) { return sum + partial; });
-  }
-  Real sum = 0;
-  for (Index begin = 0; begin < count; begin += kReductionBlock) {
-    sum += kernel(begin, std::min(begin + kReductionBlock, count));
-  }
-  return sum;
 }
 
 void FilteredPcg::prepareGaussSeidel(const BlockSparseMatrix& A) {
@@ -386,7 +360,7 @@ Real FilteredPcg::forwardSweep(const VertexFilter& filter,
   Real sum = 0;
   for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
-    sum += sumInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+    sum += sumOverBlocks(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
       return forwardSweepRange<curvature>(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering,
                                           filter, m_inverseDiagonal, c, t, w);
     });
@@ -398,7 +372,7 @@ void FilteredPcg::backwardSweep(const VertexFilter& filter,
                                 const Vec3Array& c, Vec3Array& t, Vec3Array& w) {
   for (Index color = m_ordering.colorCount(); color-- > 0;) {
     const Index first = m_ordering.colorBegin(color);
-    forEachInRange(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+    forEachBlock(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
       backwardSweepRange(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
                          m_inverseDiagonal, c, t, w);
     });

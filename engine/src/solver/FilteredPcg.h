@@ -209,22 +209,15 @@ class FilteredPcg {
                            TaskSystem* tasks = nullptr);
 
  private:
-  /// Runs kernel(begin, end) over the reduction blocks in order and returns the sum of the
-  /// returned partials, combined in block order (the deterministic reduction).
+  /// Runs kernel(begin, end) over the fixed reduction blocks of [0, count) (all vertices, or a
+  /// colour's vertex list) and returns the sum of the returned partials, combined in block order
+  /// (the deterministic reduction).
   template <typename Kernel>
-  auto sumOverBlocks(Index vertexCount, Kernel&& kernel);
+  auto sumOverBlocks(Index count, Kernel&& kernel);
 
-  /// Runs kernel(begin, end) over the reduction blocks in order (no reduction).
+  /// Runs kernel(begin, end) over the fixed reduction blocks of [0, count) (no reduction).
   template <typename Kernel>
-  void forEachBlock(Index vertexCount, Kernel&& kernel);
-
-  /// Runs kernel(begin, end) over fixed blocks of [0, count) (a colour's vertex list).
-  template <typename Kernel>
-  void forEachInRange(Index count, Kernel&& kernel);
-
-  /// Sums kernel(begin, end) over fixed blocks of [0, count), in block order.
-  template <typename Kernel>
-  Real sumInRange(Index count, Kernel&& kernel);
+  void forEachBlock(Index count, Kernel&& kernel);
 
   /// w = P_L⁻¹ w in place, colour by colour; with curvature, returns Σ cᵀ(t + w).
   template <bool curvature>
