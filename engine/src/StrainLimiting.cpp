@@ -17,6 +17,17 @@ constexpr TaskSystem::Index kGrainEdges = kGrainVertices;
 // would fix it through the small remainder grows without bound.
 constexpr Real kSmallestHeldWeight = 1e-3;
 
+// The weight an over-long edge's correction sees when each end may move only across its contact
+// normal (zero: free): w (1 − (n·d)²) per end, d the edge's direction. Zero for an edge whose ends
+// are both held (nearly) along it, which cannot be corrected without pushing into a surface and
+// is left to the collisions.
+Real heldWeight(Real weightA, Real weightB, const Vec3& normalA, const Vec3& normalB,
+                const Vec3& direction) {
+  const Real alongA = normalA.dot(direction), alongB = normalB.dot(direction);
+  const Real held = weightA * (1 - alongA * alongA) + weightB * (1 - alongB * alongB);
+  return held > kSmallestHeldWeight * (weightA + weightB) ? held : 0;
+}
+
 }  // namespace
 
 StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
@@ -77,9 +88,8 @@ void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasse
       const Vec3& normalA = contactNormals[edge.a];
       const Vec3& normalB = contactNormals[edge.b];
       const Vec3 direction = delta / length;
-      const Real alongA = normalA.dot(direction), alongB = normalB.dot(direction);
-      const Real held = weightA * (1 - alongA * alongA) + weightB * (1 - alongB * alongB);
-      if (!(held > kSmallestHeldWeight * weightSum)) continue;
+      const Real held = heldWeight(weightA, weightB, normalA, normalB, direction);
+      if (held == 0) continue;
       const Vec3 impulse = ((length - longest) / held) * direction;
       shiftA = weightA * impulse;
       shiftA -= normalA.dot(shiftA) * normalA;
@@ -113,6 +123,7 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
   const Real inverseStep = 1 / h;
   const Index edgeCount = Index(m_edges.size());
   const auto sum = [](Index a, Index b) { return a + b; };
+  const bool jacobi = settings.order != StrainLimitOrder::GaussSeidel;
 
   StrainLimitReport report;
   for (int iteration = 0;; ++iteration) {
@@ -129,23 +140,18 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
             const Real length = delta.norm();
             const Real longest = stretchFactor * edge.restLength;
             if (inContact && length > longest && weightSum > 0) {
-              // A held end moves only across its normal: its weight along the edge is w (1 −
-              // (n·d)²). An edge whose ends are both held along it (weight ≈ 0) cannot be
-              // corrected without pushing into a surface and is left to the collisions.
-              const Vec3 direction = delta / length;
-              const Real alongA = contactNormals[edge.a].dot(direction);
-              const Real alongB = contactNormals[edge.b].dot(direction);
-              const Real held = inverseMasses[edge.a] * (1 - alongA * alongA) +
-                                inverseMasses[edge.b] * (1 - alongB * alongB);
-              weightSum = held > kSmallestHeldWeight * weightSum ? held : 0;
+              weightSum = heldWeight(inverseMasses[edge.a], inverseMasses[edge.b],
+                                     contactNormals[edge.a], contactNormals[edge.b],
+                                     delta / length);
             }
-            if (!(length > longest) || weightSum == 0) {
-              m_overLimit[e] = 0;
-              continue;
+            const bool over = length > longest && weightSum != 0;
+            // The Gauss–Seidel sweep works out each edge's impulse as it goes; only the Jacobi
+            // gather below reads these.
+            if (jacobi) {
+              m_overLimit[e] = over;
+              if (over) m_impulses[e] = ((length - longest) / (weightSum * length)) * delta;
             }
-            m_overLimit[e] = 1;
-            m_impulses[e] = ((length - longest) / (weightSum * length)) * delta;
-            blockOver += length > tolerantFactor * edge.restLength;
+            if (over) blockOver += length > tolerantFactor * edge.restLength;
           }
           return blockOver;
         },
@@ -154,7 +160,7 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
     if (over == 0 || iteration == settings.maxIterations) break;
     report.iterations = iteration + 1;
 
-    if (settings.order == StrainLimitOrder::GaussSeidel) {
+    if (!jacobi) {
       sweep(stretchFactor, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
       continue;
     }
