@@ -200,12 +200,19 @@ void ClothForces::buildIsometricBending() {
   m_stencilResiduals.assign(stencils.size(), Vec3::Zero());
 }
 
+namespace {
+
+// Every pair of an element's vertices (each once, in element order): the blocks it couples.
+void appendAllPairs(std::span<const Index> vertices, std::vector<std::array<Index, 2>>& pairs) {
+  for (std::size_t a = 0; a < vertices.size(); ++a)
+    for (std::size_t b = a + 1; b < vertices.size(); ++b) pairs.push_back({vertices[a], vertices[b]});
+}
+
+}  // namespace
+
 std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
   std::vector<std::array<Index, 2>> pairs;
-  auto addAll = [&pairs](const auto& vertices) {
-    for (std::size_t a = 0; a < vertices.size(); ++a)
-      for (std::size_t b = a + 1; b < vertices.size(); ++b) pairs.push_back({vertices[a], vertices[b]});
-  };
+  const auto addAll = [&pairs](std::span<const Index> vertices) { appendAllPairs(vertices, pairs); };
   for (const auto& element : m_triangles) addAll(element.vertices);
   for (const auto& element : m_hinges) addAll(element.vertices);
   for (const auto& element : m_springs) addAll(element.vertices);
@@ -219,10 +226,7 @@ std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
 
 std::vector<std::array<Index, 2>> ClothForces::potentialCoupledPairs() const {
   std::vector<std::array<Index, 2>> pairs;
-  auto addAll = [&pairs](std::span<const Index> vertices) {
-    for (std::size_t a = 0; a < vertices.size(); ++a)
-      for (std::size_t b = a + 1; b < vertices.size(); ++b) pairs.push_back({vertices[a], vertices[b]});
-  };
+  const auto addAll = [&pairs](std::span<const Index> vertices) { appendAllPairs(vertices, pairs); };
   const ClothModel& model = *m_model;
   if (m_settings.model == ForceModel::BaraffWitkin) {
     for (const TriangleRest& triangle : model.triangles()) addAll(triangle.vertices);
