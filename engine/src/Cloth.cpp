@@ -372,10 +372,15 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
 Vec3 Cloth::teleportDisplacement() const {
   const Real threshold = m_settings.solver.pinTeleportDistance * m_model->characteristicLength();
   if (threshold <= 0 || m_pinEnd.empty()) return Vec3::Zero();
+  // Every pin must jump: one pin yanked far while the others stay is motion to simulate (the
+  // substep rule follows it), not the whole cloth changing place.
   Vec3 mean = Vec3::Zero();
-  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) mean += m_pinEnd[k] - m_pinStart[k];
-  mean /= Real(m_pinEnd.size());
-  return mean.norm() > threshold ? mean : Vec3::Zero();
+  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
+    const Vec3 jump = m_pinEnd[k] - m_pinStart[k];
+    if (!(jump.norm() > threshold)) return Vec3::Zero();
+    mean += jump;
+  }
+  return mean / Real(m_pinEnd.size());
 }
 
 Real Cloth::computeForces(const Vec3Array& x, const Vec3Array& v, Real, Vec3Array& f) {

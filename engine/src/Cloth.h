@@ -95,8 +95,9 @@ class Cloth final : public DynamicSystem {
   /// pin moves farther than an edge per substep towards the targets set for the frame.
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
 
-  /// The pins' mean displacement from the frame-start to the set targets when it is farther
-  /// than SolverSettings::pinTeleportDistance cloth sizes (the frame is a teleport), else zero.
+  /// The pins' mean displacement from the frame-start to the set targets when every pin moves
+  /// farther than SolverSettings::pinTeleportDistance cloth sizes (the frame is a teleport),
+  /// else zero.
   Vec3 teleportDisplacement() const;
 
   Status setPinTargets(std::span<const Vec3> targets);
