@@ -153,6 +153,11 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
            std::to_string(solver.maxPinTravelPerSubstep) +
            " must be a finite number of edge lengths >= 0 (0 = no limit)";
   }
+  if (!(solver.pinTeleportDistance >= 0) || !std::isfinite(solver.pinTeleportDistance)) {
+    return "cloth settings: solver.pinTeleportDistance = " +
+           std::to_string(solver.pinTeleportDistance) +
+           " must be a finite number of cloth sizes >= 0 (0 = pins never teleport the cloth)";
+  }
   if (!settings.translation.allFinite() || !settings.rotation.allFinite()) {
     return "cloth settings: translation or rotation contains NaN or infinity";
   }
@@ -346,10 +351,12 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
     }
     // Pins are kinematic drivers: no substep may carry one farther than
     // maxPinTravelPerSubstep edges (SolverSettings says why). Only a fast pin asks for more; the
-    // cap still holds.
+    // cap still holds. In a teleport frame the cloth is carried and the pins travel relative
+    // to it.
+    const Vec3 carried = teleportDisplacement();
     Real travel = 0;
     for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
-      travel = std::max(travel, (m_pinEnd[k] - m_pinStart[k]).norm());
+      travel = std::max(travel, (m_pinEnd[k] - m_pinStart[k] - carried).norm());
     }
     const Real reach = solver.maxPinTravelPerSubstep * m_meanEdgeLength;
     const Real pinWanted = reach > 0 ? std::ceil(travel / reach * (1 - 1e-9)) : 0;
@@ -360,6 +367,20 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
     *predictedUnstable = true;
   }
   return substeps;
+}
+
+Vec3 Cloth::teleportDisplacement() const {
+  const Real threshold = m_settings.solver.pinTeleportDistance * m_model->characteristicLength();
+  if (threshold <= 0 || m_pinEnd.empty()) return Vec3::Zero();
+  // Every pin must jump: one pin yanked far while the others stay is motion to simulate (the
+  // substep rule follows it), not the whole cloth changing place.
+  Vec3 mean = Vec3::Zero();
+  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
+    const Vec3 jump = m_pinEnd[k] - m_pinStart[k];
+    if (!(jump.norm() > threshold)) return Vec3::Zero();
+    mean += jump;
+  }
+  return mean / Real(m_pinEnd.size());
 }
 
 Real Cloth::computeForces(const Vec3Array& x, const Vec3Array& v, Real, Vec3Array& f) {
@@ -798,6 +819,16 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
     report.woke = true;
   }
   m_wakeRequested = false;
+
+  // A teleport (SolverSettings::pinTeleportDistance): the cloth is carried with its pins' mean
+  // jump before the frame, velocities unchanged, so it arrives instead of being flung; the pins
+  // then move only relative to it. Before the rollback copy, so a failed frame stays carried.
+  const Vec3 carried = teleportDisplacement();
+  if (!carried.isZero()) {
+    for (Vec3& x : m_positions) x += carried;
+    for (Vec3& start : m_pinStart) start += carried;
+    report.teleported = true;
+  }
 
   bool predictedUnstable = false;
   Index substeps = plannedSubsteps(frameDt, &predictedUnstable);

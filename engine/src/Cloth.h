@@ -41,6 +41,7 @@ struct ClothFrameReport {
   ClothStageCounters stages;
   bool sleeping = false;  ///< the cloth slept through the frame (not stepped)
   bool woke = false;      ///< the cloth was asleep and woke at the start of the frame
+  bool teleported = false;  ///< carried with its pins' jump (SolverSettings::pinTeleportDistance)
   SelfCollisionReport selfCollision;  ///< summed over substeps
   Index contacts = 0;  ///< vertices touching colliders at the end of the frame
   IntegratorReport integrator;
@@ -93,6 +94,11 @@ class Cloth final : public DynamicSystem {
   /// explicit method would need more than maxSubsteps. In automatic mode also enough that no
   /// pin moves farther than an edge per substep towards the targets set for the frame.
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
+
+  /// The pins' mean displacement from the frame-start to the set targets when every pin moves
+  /// farther than SolverSettings::pinTeleportDistance cloth sizes (the frame is a teleport),
+  /// else zero.
+  Vec3 teleportDisplacement() const;
 
   Status setPinTargets(std::span<const Vec3> targets);
   /// N per vertex, added to every evaluation until changed; an empty span removes them.

@@ -441,6 +441,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames, plan);
     stats.sleepingCloths += report.sleeping;
     stats.wokenCloths += report.woke;
+    stats.teleportedCloths += report.teleported;
     stats.colliderNarrowPhases += report.stages.colliderNarrowPhases;
     stats.colliderNarrowPhasesSkipped += report.stages.colliderNarrowPhasesSkipped;
     stats.selfCollisionPasses += report.stages.selfCollisionPasses;

@@ -363,7 +363,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   if (!reader.expectObject(object, path, "solver settings")) return;
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
-                    "newtonIterations", "cgTolerance", "cgMaxIterations", "warmStart"});
+                    "pinTeleportDistance", "newtonIterations", "cgTolerance", "cgMaxIterations", "warmStart"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
     const std::optional<IntegratorKind> kind = integratorFromName(name);
@@ -384,6 +384,8 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readInteger(object, path, "maxSubsteps", s.maxSubsteps, 1, 1000000);
   reader.readReal(object, path, "maxPinTravelPerSubstep", s.maxPinTravelPerSubstep, Range::NonNegative,
                   "mean edge lengths");
+  reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
+                  "cloth sizes");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
   reader.readReal(object, path, "cgTolerance", s.cgTolerance, Range::Positive, "relative residual");
   reader.readInteger(object, path, "cgMaxIterations", s.cgMaxIterations, 1, 1000000);

@@ -1,8 +1,12 @@
 // Pins that jump far in one frame (stress scene 10, issue 9), and the energy a sleeping cloth
 // reports:
-//   - automatic substepping keeps every pin within one mean edge length per substep, so a cloth
-//     whose pins jump 10 m is hauled after them within its strain limit in that frame (in one
-//     substep the limiter stopped at its iteration cap with almost every edge far over);
+//   - when every pin jumps farther than SolverSettings::pinTeleportDistance cloth sizes, the
+//     frame is a teleport: the cloth is carried by the pins' mean jump, velocities unchanged, and
+//     continues as if nothing had happened; one pin yanked alone is no teleport;
+//   - otherwise (or with the teleport off), automatic substepping keeps every pin within one mean
+//     edge length per substep, so a cloth whose pins jump 10 m is hauled after them within its
+//     strain limit in that frame (in one substep the limiter stopped at its iteration cap with
+//     almost every edge far over);
 //   - a sleeping cloth reports the potential energy of its last stepped frame, not 0 J (the stress
 //     scene measured its settled energy on a sleeping cloth and got a baseline of 0 J).
 #include <weft/engine/FabricPresets.h>
@@ -12,6 +16,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -46,10 +51,18 @@ Real meanEdgeLength(const ClothModel& model) {
   return sum / Real(model.edges().size());
 }
 
+// Cotton hanging from its top row, with the teleport rule off: pins drag the cloth however far
+// they jump.
+ClothSettings draggedCotton() {
+  ClothSettings settings = hangingCotton();
+  settings.solver.pinTeleportDistance = 0;
+  return settings;
+}
+
 TEST(PinTeleport, PlannedSubstepsKeepEveryPinWithinAnEdge) {
   const auto model = sheet();
   World world;
-  const ClothId cloth = world.createCloth(model, hangingCotton()).value();
+  const ClothId cloth = world.createCloth(model, draggedCotton()).value();
   // Still pins: the stability rule alone (one implicit substep per 1/60 s frame).
   EXPECT_EQ(world.plannedSubsteps(cloth, kFrameDt).value(), 1);
   std::vector<Vec3> targets = world.pinTargets(cloth).value();
@@ -57,21 +70,26 @@ TEST(PinTeleport, PlannedSubstepsKeepEveryPinWithinAnEdge) {
   ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
   const Index substeps = world.plannedSubsteps(cloth, kFrameDt).value();
   EXPECT_EQ(substeps, Index(std::ceil(10.0 / meanEdgeLength(*model) * (1 - 1e-9))));
+  // With the default teleport rule the same jump carries the cloth: its pins do not move relative
+  // to it, so the stability rule alone.
+  const ClothId teleported = world.createCloth(model, hangingCotton()).value();
+  ASSERT_TRUE(world.setPinTargets(teleported, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(teleported, kFrameDt).value(), 1);
   // Fixed substeps are the caller's choice and stay as given.
-  ClothSettings fixed = hangingCotton();
+  ClothSettings fixed = draggedCotton();
   fixed.solver.substeps = 2;
   const ClothId fixedCloth = world.createCloth(model, fixed).value();
   ASSERT_TRUE(world.setPinTargets(fixedCloth, targets).ok());
   EXPECT_EQ(world.plannedSubsteps(fixedCloth, kFrameDt).value(), 2);
   // The allowed travel is a setting: 4 edges a substep need a quarter of the substeps (rounded
   // up), 0 turns the rule off.
-  ClothSettings looser = hangingCotton();
+  ClothSettings looser = draggedCotton();
   looser.solver.maxPinTravelPerSubstep = 4;
   const ClothId looserCloth = world.createCloth(model, looser).value();
   ASSERT_TRUE(world.setPinTargets(looserCloth, targets).ok());
   EXPECT_EQ(world.plannedSubsteps(looserCloth, kFrameDt).value(),
             Index(std::ceil(10.0 / (4 * meanEdgeLength(*model)) * (1 - 1e-9))));
-  ClothSettings off = hangingCotton();
+  ClothSettings off = draggedCotton();
   off.solver.maxPinTravelPerSubstep = 0;
   const ClothId offCloth = world.createCloth(model, off).value();
   ASSERT_TRUE(world.setPinTargets(offCloth, targets).ok());
@@ -91,10 +109,11 @@ TEST(PinTeleport, ANegativeOrNonFinitePinTravelIsRefusedByName) {
   EXPECT_EQ(world.clothCount(), 0u);
 }
 
-TEST(PinTeleport, ClothFollowsATenMetreJumpWithinItsStrainLimit) {
+TEST(PinTeleport, ClothDraggedTenMetresFollowsWithinItsStrainLimit) {
   // Self-collision off: this is about the solve and the strain limiter following the pins. Awake
-  // (sleep off), so the cloth starts the jump with the small motions of a hanging sheet.
-  ClothSettings settings = hangingCotton();
+  // (sleep off), so the cloth starts the jump with the small motions of a hanging sheet. The
+  // teleport rule is off, so the pins drag the cloth.
+  ClothSettings settings = draggedCotton();
   settings.selfCollision = false;
   settings.sleep.enabled = false;
   World world;
@@ -127,7 +146,7 @@ TEST(PinTeleport, TheJumpAndTheCrashAfterItGiveTheSameBitsOnOneAndTwoThreads) {
     WorldSettings worldSettings;
     worldSettings.threadCount = threads;
     World world(worldSettings);
-    const ClothId cloth = world.createCloth(sheet(), hangingCotton()).value();
+    const ClothId cloth = world.createCloth(sheet(), draggedCotton()).value();
     for (int frame = 0; frame < 30; ++frame) world.step(kFrameDt);
     std::vector<Vec3> targets = world.pinTargets(cloth).value();
     for (Vec3& target : targets) target.x() += 10.0;
@@ -143,6 +162,107 @@ TEST(PinTeleport, TheJumpAndTheCrashAfterItGiveTheSameBitsOnOneAndTwoThreads) {
     EXPECT_EQ(one[i].y(), two[i].y()) << i;
     EXPECT_EQ(one[i].z(), two[i].z()) << i;
   }
+}
+
+// The settled sheet of two worlds, awake and still moving a little; one world's pins jump by
+// `jump` (every pin the same), the other's stay.
+struct TwinWorlds {
+  World jumped, stayed;
+  ClothId jumpedCloth, stayedCloth;
+  explicit TwinWorlds(const ClothSettings& settings) {
+    jumpedCloth = jumped.createCloth(sheet(), settings).value();
+    stayedCloth = stayed.createCloth(sheet(), settings).value();
+    for (int frame = 0; frame < 20; ++frame) {
+      jumped.step(kFrameDt);
+      stayed.step(kFrameDt);
+    }
+  }
+};
+
+TEST(PinTeleport, PinsThatAllJumpCarryTheClothWhichGoesOnAsIfNothingHappened) {
+  ClothSettings settings = hangingCotton();
+  settings.sleep.enabled = false;
+  TwinWorlds twins(settings);
+  const Vec3 jump(10.0, 2.0, -3.0);
+  std::vector<Vec3> targets = twins.jumped.pinTargets(twins.jumpedCloth).value();
+  for (Vec3& target : targets) target += jump;
+  ASSERT_TRUE(twins.jumped.setPinTargets(twins.jumpedCloth, targets).ok());
+  EXPECT_GT(twins.jumped.stats().kineticEnergy, 0.0);  // the sheet still moves when it jumps
+  Real largestGap = 0, largestVelocityGap = 0;
+  for (int frame = 0; frame < 60; ++frame) {
+    const StepStatus status = twins.jumped.step(kFrameDt);
+    twins.stayed.step(kFrameDt);
+    EXPECT_EQ(status, StepStatus::Ok) << frame;
+    EXPECT_EQ(twins.jumped.stats().teleportedCloths, frame == 0 ? 1u : 0u) << frame;
+    EXPECT_EQ(twins.jumped.stats().substeps, 1) << frame;  // no pin moves relative to the cloth
+    const auto x = twins.jumped.positions(twins.jumpedCloth).value();
+    const auto v = twins.jumped.velocities(twins.jumpedCloth).value();
+    const auto y = twins.stayed.positions(twins.stayedCloth).value();
+    const auto w = twins.stayed.velocities(twins.stayedCloth).value();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      largestGap = std::max(largestGap, (x[i] - jump - y[i]).norm());
+      largestVelocityGap = std::max(largestVelocityGap, (v[i] - w[i]).norm());
+    }
+    if (frame == 0) {
+      // The jump's velocities are those of a sheet that did not jump, not 600 m/s.
+      EXPECT_LT(twins.jumped.stats().maxSpeed, 1.0);
+    }
+  }
+  std::printf("[pin teleport] carried sheet against the one that stayed over 1 s: %.3g m, %.3g m/s\n",
+              largestGap, largestVelocityGap);
+  // Only round-off apart (positions 10 m from the origin instead of 0.3 m).
+  EXPECT_LT(largestGap, 1e-9);
+  EXPECT_LT(largestVelocityGap, 1e-7);
+  // Pins are at their targets bit for bit.
+  const auto x = twins.jumped.positions(twins.jumpedCloth).value();
+  const std::vector<Index>& pins = settings.pinnedVertices;
+  for (std::size_t k = 0; k < pins.size(); ++k) EXPECT_EQ(x[pins[k]], targets[k]) << k;
+}
+
+TEST(PinTeleport, OnePinYankedAloneOrAShortJumpIsDraggedNotCarried) {
+  const auto model = sheet();
+  World world;
+  ClothSettings settings = hangingCotton();
+  settings.selfCollision = false;
+  const ClothId yanked = world.createCloth(model, settings).value();
+  const ClothId shortJump = world.createCloth(model, settings).value();
+  const ClothId longJump = world.createCloth(model, settings).value();
+  const Real size = model->characteristicLength();
+  // One corner pin yanked 10 m: the substep rule follows it.
+  std::vector<Vec3> targets = world.pinTargets(yanked).value();
+  targets[0].x() += 10.0;
+  ASSERT_TRUE(world.setPinTargets(yanked, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(yanked, kFrameDt).value(),
+            Index(std::ceil(10.0 / meanEdgeLength(*model) * (1 - 1e-9))));
+  // Every pin moving 0.9 of the cloth's size: dragged (more than one edge, so more substeps).
+  targets = world.pinTargets(shortJump).value();
+  for (Vec3& target : targets) target.z() += 0.9 * size;
+  ASSERT_TRUE(world.setPinTargets(shortJump, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(shortJump, kFrameDt).value(),
+            Index(std::ceil(0.9 * size / meanEdgeLength(*model) * (1 - 1e-9))));
+  // 1.1 of its size: carried, one substep.
+  targets = world.pinTargets(longJump).value();
+  for (Vec3& target : targets) target.z() += 1.1 * size;
+  ASSERT_TRUE(world.setPinTargets(longJump, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(longJump, kFrameDt).value(), 1);
+  world.step(kFrameDt);
+  EXPECT_EQ(world.stats().teleportedCloths, 1u);
+  // The yanked and short-jump cloths were dragged: their far edge lags behind its pins.
+  EXPECT_LT(world.positions(shortJump).value()[0].z(), 0.9 * size - 1e-3);
+  EXPECT_NEAR(world.positions(longJump).value()[0].z(), 1.1 * size, 1e-3);
+}
+
+TEST(PinTeleport, ANegativeOrNonFiniteTeleportDistanceIsRefusedByName) {
+  World world;
+  for (Real bad : {Real(-0.5), std::nan(""), std::numeric_limits<Real>::infinity()}) {
+    ClothSettings settings = hangingCotton();
+    settings.solver.pinTeleportDistance = bad;
+    const Result<ClothId> cloth = world.createCloth(sheet(), settings);
+    ASSERT_FALSE(cloth.ok());
+    EXPECT_NE(cloth.error().message.find("pinTeleportDistance"), std::string::npos)
+        << cloth.error().message;
+  }
+  EXPECT_EQ(world.clothCount(), 0u);
 }
 
 TEST(PinTeleport, ASleepingClothReportsThePotentialEnergyItSettledWith) {

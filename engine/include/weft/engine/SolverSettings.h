@@ -48,17 +48,35 @@ struct SolverSettings {
   /// Substeps per frame; 0 = automatic: implicit takes enough that h ≤ maxImplicitStep, explicit
   /// methods take enough that the stiffest mode of the rest state is stable, and either takes
   /// enough that no pin moves more than maxPinTravelPerSubstep mean rest edge lengths per
-  /// substep (a pin jumping 10 m on a 5 cm mesh: 200), up to maxSubsteps.
+  /// substep (a pin moving 10 m in one frame on a 5 cm mesh, with pinTeleportDistance off or the
+  /// other pins staying: 200), up to maxSubsteps. In a teleport frame (pinTeleportDistance) the
+  /// rule measures each pin's travel relative to the carried cloth.
   Index substeps = 0;
   /// Mean rest edge lengths a pin may travel in one automatic substep; 0 = no limit. A pin is a
   /// kinematic driver, and neither the linearised implicit step nor the strain limiter nor the
   /// swept self-collision test can follow one that jumps far past its neighbours in one substep.
-  /// 1 is the measured safe value (stress scene 10: pins moved 10 m in one frame end the frame at
-  /// the strain limit with it; at 4 the frame ends at 0.14, and in one substep at 17.9). It costs
-  /// substeps whenever pins move fast: a cape pinned to a character running at 6 m/s on a 3 cm
-  /// mesh takes 4 substeps a frame at 60 Hz. A game that moves pins fast and can accept more
-  /// strain in those frames raises it; a teleport of the whole cloth is World::setState.
+  /// 1 is the measured safe value (stress scene 10 with pinTeleportDistance off: pins moved 10 m
+  /// in one frame end the frame at the strain limit with it; at 4 the frame ends at 0.14, and in
+  /// one substep at 17.9). It costs substeps whenever pins move fast: a cape pinned to a
+  /// character running at 6 m/s on a 3 cm mesh takes 4 substeps a frame at 60 Hz. A game that
+  /// moves pins fast and can accept more strain in those frames raises it. Pins that all jump far are a teleport instead
+  /// (pinTeleportDistance); a teleport of the whole cloth to a given state is World::setState.
   Real maxPinTravelPerSubstep = 1;
+  /// Cloth sizes (ClothModel::characteristicLength, the rest shape's bounding-box diagonal) a pin
+  /// may move in one frame before the frame is a teleport, when every pin of the cloth moves
+  /// farther than that; 0 = never. A teleport frame carries the whole cloth by the pins' mean
+  /// displacement at its start, velocities unchanged, and simulates only the pins' motion
+  /// relative to it (none when they all jump together), under the substep rule above; one pin
+  /// yanked far while the others stay is no teleport. So setPinTargets() moving a hanging
+  /// cloth's pins 10 m puts it there hanging as before, the way game engines treat a character
+  /// that jumps farther in a frame than it could move (a respawn, a cut). Off, the pins drag the
+  /// cloth at 600 m/s through that frame and stop dead at its end; the cloth crashes into them
+  /// and can stay crushed in folds held by self-contact (stress scene 10 with it off: 6 of 24
+  /// round-off-level perturbations do not settle within 2 s, bench weft-teleport-perturb).
+  /// Pins that move their cloth's size in every frame (a 0.7 m flag on a vehicle at 42 m/s at
+  /// 60 Hz) are carried every frame, so the cloth no longer feels that motion (nor the air it
+  /// moves through): raise it or turn it off for such a cloth.
+  Real pinTeleportDistance = 1;
   Real maxImplicitStep = 1.0 / 60.0;  ///< s, largest implicit substep in automatic mode
   /// Cap on automatic substeps per frame; an explicit method that would need more is stepped at
   /// the cap and reported unstable (StepStatus::Unstable), never silently.

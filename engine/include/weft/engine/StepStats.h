@@ -112,6 +112,8 @@ struct StepStats {
   Index dampingJacobians = 0;      ///< assemblies that formed damping (∂f/∂v) Jacobians
   Index sleepingCloths = 0;        ///< cloths asleep during this frame (not stepped)
   Index wokenCloths = 0;           ///< cloths that woke at the start of this frame
+  /// Cloths carried with their pins' jump this frame (SolverSettings::pinTeleportDistance).
+  Index teleportedCloths = 0;
   StepStatus status = StepStatus::Ok;  ///< the flags step() returned
   Index clothContacts = 0;     ///< proximity pairs between different cloths repelled
   Index clothImpacts = 0;      ///< swept collisions resolved at the frame's cloth–cloth pass
