@@ -558,10 +558,14 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
     for (Index i = 0; i < vertexCount(); ++i) {
       m_heldInverseMasses[i] = m_contactHolds.fixed[i] ? 0 : m_inverseMasses[i];
     }
+    // The self-contacts of the last self-collision pass are held too, one-sided: the limiter
+    // may move a pair apart or slide it, not push it closer than that pass left it.
+    std::span<const SeparationHold> separations;
+    if (selfCollision) separations = m_selfCollision->separationHolds();
     const StrainLimitReport limited =
         m_strainLimiter->applyInContact(m_strainLimitSettings, m_heldInverseMasses,
                                         m_contactHolds.normals, h, m_positions, m_velocities,
-                                        *m_tasks);
+                                        *m_tasks, separations);
     report.strainLimit.iterations += limited.iterations;
     edgesOverLimit = limited.edgesOverLimit;
     if (limited.iterations == 0) break;  // nothing over the limit: the collisions stand

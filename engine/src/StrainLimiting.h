@@ -74,10 +74,22 @@
 #include <weft/engine/ClothModel.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <array>
 #include <span>
 #include <vector>
 
 namespace weft {
+
+/// A pair of features in contact that the limiter keeps apart (applyInContact): vertex–triangle
+/// (p; a, b, c) with weights (1, −b₀, −b₁, −b₂), or edge–edge with (1 − s, s, −(1 − u), −u), as in
+/// ContactResolver. The limiter keeps normal · Σ weights[k] x[vertices[k]] ≥ separation: it may
+/// move the pair apart or let it slide, never closer than that.
+struct SeparationHold {
+  std::array<Index, 4> vertices{};
+  std::array<Real, 4> weights{};
+  Vec3 normal = Vec3::Zero();  ///< unit, from the second side (triangle, second edge) to the first
+  Real separation = 0;         ///< m, the smallest separation along the normal allowed
+};
 
 /// How the strain limiter orders its corrections within one iteration.
 enum class StrainLimitOrder {
@@ -127,20 +139,32 @@ class StrainLimiter {
   /// per vertex) is held along it — its corrections lose their part along the normal, and its
   /// edges weigh it by w_i (1 − (n_i·d)²) — so the limiter slides it on the surface it rests on
   /// but neither pushes it in nor pulls it off. A zero normal leaves the vertex free.
+  ///
+  /// `separations` are the cloth's self-contacts (SelfCollision::separationHolds()): after every
+  /// pass over the edges, each pair closer than its separation along its normal is pushed back
+  /// to it (Gauss–Seidel, in pair order, the same inverse masses and surface holds), so that the
+  /// limiter and the contacts are solved together (see the design note).
   StrainLimitReport applyInContact(const StrainLimitSettings& settings,
                                    std::span<const Real> inverseMasses,
                                    std::span<const Vec3> contactNormals, Real h, std::span<Vec3> x,
-                                   std::span<Vec3> v, TaskSystem& tasks);
+                                   std::span<Vec3> v, TaskSystem& tasks,
+                                   std::span<const SeparationHold> separations = {});
 
  private:
   StrainLimitReport run(const StrainLimitSettings& settings, std::span<const Real> inverseMasses,
-                        std::span<const Vec3> contactNormals, Real h, std::span<Vec3> x,
+                        std::span<const Vec3> contactNormals,
+                        std::span<const SeparationHold> separations, Real h, std::span<Vec3> x,
                         std::span<Vec3> v, TaskSystem& tasks);
 
   // One Gauss–Seidel pass over every edge over the limit, forward or backward in edge order.
   void sweep(Real stretchFactor, std::span<const Real> inverseMasses,
              std::span<const Vec3> contactNormals, Real inverseStep, bool backward,
              std::span<Vec3> x, std::span<Vec3> v) const;
+  // One Gauss–Seidel pass over the self-contacts, forward or backward in pair order: every pair
+  // closer than its separation is moved apart to it.
+  static void separate(std::span<const SeparationHold> separations,
+                       std::span<const Real> inverseMasses, std::span<const Vec3> contactNormals,
+                       Real inverseStep, bool backward, std::span<Vec3> x, std::span<Vec3> v);
 
   struct LimitedEdge {
     Index a = 0, b = 0;
