@@ -272,6 +272,12 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
     m_contactHolds.normals.assign(n, Vec3::Zero());
     m_contactHolds.fixed.assign(n, 0);
     m_heldInverseMasses.assign(n, 0);
+    // Only a cloth whose masses spread beyond kHeldContactMassRatio can have a self-contact the
+    // limiter holds; the others do not pay for recording them.
+    if (m_selfCollision && !mass.empty()) {
+      const auto [lightest, heaviest] = std::minmax_element(mass.begin(), mass.end());
+      m_selfCollision->setRecordSeparations(*heaviest > kHeldContactMassRatio * *lightest);
+    }
   }
   m_skipStages = world.skipUnneededStages;
   estimateStiffestMode();

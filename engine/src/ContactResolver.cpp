@@ -335,6 +335,7 @@ void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpee
 }
 
 void ContactResolver::holdContacts() {
+  if (!m_recordSeparations) return;
   for (const Contact& contact : m_contacts) {
     m_separationHolds.push_back(SeparationHold{contact.vertices, contact.weights, contact.normal,
                                                contact.thickness});

@@ -109,7 +109,10 @@ class ContactResolver {
   /// left them at, capped at the pair's thickness: what the strain limiter run after it must not
   /// undo (StrainLimiter::applyInContact). Pairs of the impact zones are not included: the zones
   /// moved them rigidly.
+  /// Recorded only after setRecordSeparations(true) (off by default: nothing to pay for a
+  /// cloth whose limiter holds no self-contacts).
   const std::vector<SeparationHold>& separationHolds() const { return m_separationHolds; }
+  void setRecordSeparations(bool record) { m_recordSeparations = record; }
 
   /// Colliders (posed at the end of the step) the next resolve() keeps corrected vertices out
   /// of; empty: none. The span must stay valid during resolve().
@@ -203,6 +206,7 @@ class ContactResolver {
   std::vector<char> m_inZone;       // 1 for vertices some impact zone holds
   std::vector<char> m_touched;      // 1 for vertices whose velocity this resolve changed
   std::vector<SeparationHold> m_separationHolds;  // see separationHolds()
+  bool m_recordSeparations = false;
 };
 
 }  // namespace weft
