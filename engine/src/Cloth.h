@@ -226,6 +226,7 @@ class Cloth final : public DynamicSystem {
   StrainLimitSettings m_strainLimitSettings;
   ContactHolds m_contactHolds;                     // with the limiter: this substep's contacts
   std::vector<Real> m_heldInverseMasses;           // 0 also for vertices on two surfaces
+  std::vector<SeparationHold> m_heldSeparations;   // self-contacts the limiter holds this round
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
   ClothStageCounters m_stages;                     // this frame's

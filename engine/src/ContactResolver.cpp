@@ -334,6 +334,14 @@ void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpee
   }
 }
 
+void ContactResolver::holdContacts() {
+  if (!m_recordSeparations) return;
+  for (const Contact& contact : m_contacts) {
+    m_separationHolds.push_back(SeparationHold{contact.vertices, contact.weights, contact.normal,
+                                               contact.thickness});
+  }
+}
+
 bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
   for (std::size_t i = 0; i < start.size(); ++i) m_end[i] = start[i] + h * m_velocity[i];
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
@@ -446,6 +454,7 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
   m_velocity.resize(n);
   m_end.resize(n);
   m_touched.assign(n, 0);
+  m_separationHolds.clear();
   if (!m_colliders.empty()) m_held.assign(n, -1);
   m_stepEnd = &x;
   for (std::size_t i = 0; i < n; ++i) m_velocity[i] = (x[i] - start[i]) / h;
@@ -518,6 +527,7 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
       clampToColliders(start, h);
     }
     report.proximityContacts += Index(m_contacts.size());
+    holdContacts();
   }
 
   // 2. Continuous detection of the corrected motion, impulses until clean (bounded).
@@ -530,6 +540,7 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
       applyImpulse(contact, kImpactSeparation * contact.thickness / h, inverseMasses);
       ++report.impacts;
     }
+    holdContacts();
     clampToColliders(start, h);
   }
 
@@ -576,6 +587,12 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
       v[i] += m_velocity[i] - (x[i] - start[i]) / h;
     }
     x[i] = start[i] + h * m_velocity[i];
+  }
+  // Each held pair may not end closer than it is now (nor need be farther than its thickness).
+  for (SeparationHold& hold : m_separationHolds) {
+    Vec3 point = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) point += hold.weights[k] * x[hold.vertices[k]];
+    hold.separation = std::min(hold.separation, hold.normal.dot(point));
   }
   return report;
 }

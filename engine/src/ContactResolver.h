@@ -49,6 +49,7 @@
 #pragma once
 
 #include "ColliderResponse.h"
+#include "StrainLimiting.h"
 
 #include <weft/Math.h>
 #include <weft/collision/Bvh.h>
@@ -102,6 +103,16 @@ class ContactResolver {
 
   /// 1 for every vertex whose velocity the last resolve() changed.
   const std::vector<char>& touched() const { return m_touched; }
+
+  /// The pairs the last resolve() found in contact (proximity at the step start, then the swept
+  /// hits of the impulse passes, in that order), each with the separation along its normal it
+  /// left them at, capped at the pair's thickness: what the strain limiter run after it must not
+  /// undo (StrainLimiter::applyInContact). Pairs of the impact zones are not included: the zones
+  /// moved them rigidly.
+  /// Recorded only after setRecordSeparations(true) (off by default: nothing to pay for a
+  /// cloth whose limiter holds no self-contacts).
+  const std::vector<SeparationHold>& separationHolds() const { return m_separationHolds; }
+  void setRecordSeparations(bool record) { m_recordSeparations = record; }
 
   /// Colliders (posed at the end of the step) the next resolve() keeps corrected vertices out
   /// of; empty: none. The span must stay valid during resolve().
@@ -163,6 +174,9 @@ class ContactResolver {
   // After a round of impulses: corrected vertices whose step ends within the thickness of a
   // collider go back onto it.
   void clampToColliders(const Vec3Array& start, Real h);
+  // Appends the pairs of m_contacts to m_separationHolds (their separations are set at the end
+  // of resolve()).
+  void holdContacts();
 
   std::vector<std::array<Index, 3>> m_triangles;      // vertex ids of each triangle
   std::vector<std::array<Index, 3>> m_triangleEdges;  // edge ids of each triangle
@@ -191,6 +205,8 @@ class ContactResolver {
   std::vector<Index> m_zoneParent;  // union–find over vertices for impact zones
   std::vector<char> m_inZone;       // 1 for vertices some impact zone holds
   std::vector<char> m_touched;      // 1 for vertices whose velocity this resolve changed
+  std::vector<SeparationHold> m_separationHolds;  // see separationHolds()
+  bool m_recordSeparations = false;
 };
 
 }  // namespace weft

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <limits>
 
 namespace weft {
 namespace {
@@ -57,17 +58,61 @@ StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
 StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
                                        std::span<const Real> inverseMasses, Real h,
                                        std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
-  return run(settings, inverseMasses, {}, h, x, v, tasks);
+  return run(settings, inverseMasses, {}, {}, h, x, v, tasks);
 }
 
 StrainLimitReport StrainLimiter::applyInContact(const StrainLimitSettings& settings,
                                                 std::span<const Real> inverseMasses,
                                                 std::span<const Vec3> contactNormals, Real h,
                                                 std::span<Vec3> x, std::span<Vec3> v,
-                                                TaskSystem& tasks) {
+                                                TaskSystem& tasks,
+                                                std::span<const SeparationHold> separations) {
   assert(contactNormals.size() == m_correctionCount.size() &&
          "StrainLimiter::applyInContact: one contact normal (zero: none) per vertex");
-  return run(settings, inverseMasses, contactNormals, h, x, v, tasks);
+  return run(settings, inverseMasses, contactNormals, separations, h, x, v, tasks);
+}
+
+void StrainLimiter::separate(std::span<const SeparationHold> separations,
+                             std::span<const Real> inverseMasses,
+                             std::span<const Vec3> contactNormals, Real inverseStep, bool backward,
+                             std::span<Vec3> x, std::span<Vec3> v) {
+  const std::size_t count = separations.size();
+  for (std::size_t k = 0; k < count; ++k) {
+    const SeparationHold& pair = separations[backward ? count - 1 - k : k];
+    Vec3 point = Vec3::Zero();
+    for (int j = 0; j < 4; ++j) point += pair.weights[j] * x[pair.vertices[j]];
+    const Real shortfall = pair.separation - pair.normal.dot(point);
+    if (!(shortfall > 0)) continue;
+    // Every movable vertex of the pair counts as heavy as the pair's heaviest (see the design
+    // note): a light sheet under a heavy weight would otherwise take almost all of each
+    // correction and give it back to the edges on the next pass, which then converges at
+    // m_light / m_heavy per iteration. Within the pair the correction is shared by the weights;
+    // a vertex held on a collider moves only across its surface's normal n_j, so its weight is
+    // w_j² W (1 − (n_j·n)²).
+    Real pairInverseMass = std::numeric_limits<Real>::infinity();
+    for (int j = 0; j < 4; ++j) {
+      const Real w = inverseMasses[pair.vertices[j]];
+      if (w > 0 && pair.weights[j] != 0) pairInverseMass = std::min(pairInverseMass, w);
+    }
+    if (!std::isfinite(pairInverseMass)) continue;  // all four pinned or held fixed
+    Real weight = 0;
+    for (int j = 0; j < 4; ++j) {
+      const Index i = pair.vertices[j];
+      if (inverseMasses[i] == 0) continue;
+      const Real along = contactNormals[i].dot(pair.normal);
+      weight += pair.weights[j] * pair.weights[j] * (1 - along * along);
+    }
+    if (!(weight > kSmallestHeldWeight)) continue;
+    const Real lambda = shortfall / (weight * pairInverseMass);
+    for (int j = 0; j < 4; ++j) {
+      const Index i = pair.vertices[j];
+      if (inverseMasses[i] == 0) continue;
+      Vec3 shift = (pair.weights[j] * pairInverseMass * lambda) * pair.normal;
+      shift -= contactNormals[i].dot(shift) * contactNormals[i];
+      x[i] += shift;
+      v[i] += inverseStep * shift;
+    }
+  }
 }
 
 void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasses,
@@ -109,7 +154,8 @@ void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasse
 
 StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
                                      std::span<const Real> inverseMasses,
-                                     std::span<const Vec3> contactNormals, Real h,
+                                     std::span<const Vec3> contactNormals,
+                                     std::span<const SeparationHold> separations, Real h,
                                      std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
   const Index vertexCount = Index(m_correctionCount.size());
   assert(x.size() == vertexCount && v.size() == vertexCount && inverseMasses.size() == vertexCount &&
@@ -162,6 +208,7 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
 
     if (!jacobi) {
       sweep(stretchFactor, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
+      separate(separations, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
       continue;
     }
 
@@ -203,6 +250,8 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
         v[i] += inverseStep * shift;
       }
     });
+    // The self-contacts after the edges, serially (they are few): the same for any thread count.
+    separate(separations, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
   }
   return report;
 }

@@ -61,23 +61,51 @@
 // fraction per iteration; within the iteration cap the light cloth around it is held but the
 // weight keeps sinking (measured: strain 0.22 at 0.5 kg, 0.44 at 1 kg on a 9 × 9 sheet).
 //
+// Self-contacts (applyInContact's `separations`). A pair of features the self-collision pass
+// found in contact (vertex–triangle or edge–edge, weights w_k summing to zero on each side,
+// normal n) is held one-sided: n · Σ w_k x_k ≥ s, s the separation the pass left it at (at most
+// the thickness). After every pass over the edges, each pair short of it is pushed apart in
+// pair order (Gauss–Seidel), so the edges and the contacts are solved in one iteration
+// (Bridson, Fedkiw & Anderson 2002 resolve contacts by the same projection with impulses).
+// Inside a pair every movable vertex counts as heavy as the pair's heaviest: with true masses a
+// 0.7 g sheet vertex under a 31 g weight takes 98 % of each separation, which the edges pull
+// back on the next pass, and the weight rises by m_light / m_heavy of the overlap per iteration
+// (stress scene 9: strain 8.1 with the cap hit every substep; 9.6 with true masses and the
+// holds; 0.103 with the pair counting heavy). The momentum this gives the heavy side is the
+// support the pins give through the taut sheet, the only case in which the limiter moves a light
+// side into a heavy one. Cloth holds only pairs of very different masses (Cloth.cpp,
+// kHeldContactMassRatio; holding every pair kept folds caught in stress scene 10). Holds with a
+// collider normal n_j see w_j² W (1 − (n_j·n)²) as above.
+//
 // The iteration stops when no correctable edge is over limit + tolerance, or after
 // maxIterations; the report says how many iterations ran and how many edges were left over.
 // Cloth runs it after the solve, then the collisions, then (Cloth::limitStrainInContact) again
 // in contact and the collisions again, a few rounds: collisions keep the last word (nothing
-// inside a collider, no crossing) even where that costs a little strain. Self-contacts are not
-// held: the self-collision pass can still stretch the cloth after the last round (heavy objects
-// resting on light cloth, jammed layers).
+// inside a collider, no crossing) even where that costs a little strain. Between features of
+// comparable masses the self-collision pass after the last round can still stretch the cloth
+// (jammed layers, stress scene 7).
 #pragma once
 
 #include <weft/Math.h>
 #include <weft/engine/ClothModel.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <array>
 #include <span>
 #include <vector>
 
 namespace weft {
+
+/// A pair of features in contact that the limiter keeps apart (applyInContact): vertex–triangle
+/// (p; a, b, c) with weights (1, −b₀, −b₁, −b₂), or edge–edge with (1 − s, s, −(1 − u), −u), as in
+/// ContactResolver. The limiter keeps normal · Σ weights[k] x[vertices[k]] ≥ separation: it may
+/// move the pair apart or let it slide, never closer than that.
+struct SeparationHold {
+  std::array<Index, 4> vertices{};
+  std::array<Real, 4> weights{};
+  Vec3 normal = Vec3::Zero();  ///< unit, from the second side (triangle, second edge) to the first
+  Real separation = 0;         ///< m, the smallest separation along the normal allowed
+};
 
 /// How the strain limiter orders its corrections within one iteration.
 enum class StrainLimitOrder {
@@ -127,20 +155,32 @@ class StrainLimiter {
   /// per vertex) is held along it — its corrections lose their part along the normal, and its
   /// edges weigh it by w_i (1 − (n_i·d)²) — so the limiter slides it on the surface it rests on
   /// but neither pushes it in nor pulls it off. A zero normal leaves the vertex free.
+  ///
+  /// `separations` are the cloth's self-contacts (SelfCollision::separationHolds()): after every
+  /// pass over the edges, each pair closer than its separation along its normal is pushed back
+  /// to it (Gauss–Seidel, in pair order, the same inverse masses and surface holds), so that the
+  /// limiter and the contacts are solved together (see the design note).
   StrainLimitReport applyInContact(const StrainLimitSettings& settings,
                                    std::span<const Real> inverseMasses,
                                    std::span<const Vec3> contactNormals, Real h, std::span<Vec3> x,
-                                   std::span<Vec3> v, TaskSystem& tasks);
+                                   std::span<Vec3> v, TaskSystem& tasks,
+                                   std::span<const SeparationHold> separations = {});
 
  private:
   StrainLimitReport run(const StrainLimitSettings& settings, std::span<const Real> inverseMasses,
-                        std::span<const Vec3> contactNormals, Real h, std::span<Vec3> x,
+                        std::span<const Vec3> contactNormals,
+                        std::span<const SeparationHold> separations, Real h, std::span<Vec3> x,
                         std::span<Vec3> v, TaskSystem& tasks);
 
   // One Gauss–Seidel pass over every edge over the limit, forward or backward in edge order.
   void sweep(Real stretchFactor, std::span<const Real> inverseMasses,
              std::span<const Vec3> contactNormals, Real inverseStep, bool backward,
              std::span<Vec3> x, std::span<Vec3> v) const;
+  // One Gauss–Seidel pass over the self-contacts, forward or backward in pair order: every pair
+  // closer than its separation is moved apart to it.
+  static void separate(std::span<const SeparationHold> separations,
+                       std::span<const Real> inverseMasses, std::span<const Vec3> contactNormals,
+                       Real inverseStep, bool backward, std::span<Vec3> x, std::span<Vec3> v);
 
   struct LimitedEdge {
     Index a = 0, b = 0;

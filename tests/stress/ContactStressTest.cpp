@@ -138,7 +138,13 @@ TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
                          "normal, but self-contacts are not held, so the self-collision pass that "
                          "keeps the last word (swept impulses between the layers) stretches them "
                          "again. Holding self-contacts the same way (the direction the pass moved "
-                         "a vertex) was tried and measured worse (0.81)"}});
+                         "a vertex) was tried and measured worse (0.81). The limiter now holds "
+                         "self-contacts inside its iteration only between very different masses "
+                         "(scene 9); holding every pair here measured 0.285, and 0.186 together "
+                         "with letting a vertex on two collider surfaces slide along their crease "
+                         "instead of fixing it (0.53 with the crease alone): a jam whose figure "
+                         "moves with every bit, where the limiter stops at its cap against vertices "
+                         "its collider holds leave no way to move"}});
 }
 
 TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) {
@@ -195,17 +201,6 @@ TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) 
   monitor.expectPasses("sphere_250_m_per_s", kCottonStrainLimit);
 }
 
-constexpr const char* kHeavyReason =
-    "0.5 kg pads (31 g per vertex) on a 0.15 kg cotton sheet (0.7 g per vertex), pinned at its "
-    "corners: the sheet still stretches to a max strain of 8.1 with the Gauss-Seidel PCG (11 with block Jacobi; 32 when the limiter "
-    "ran only before the collisions, 45 without it). The pads touch the sheet only through the "
-    "self-collision: every substep it hands the pads' momentum to the light sheet vertices under "
-    "them; the limiter run after it (Gauss-Seidel, self-contacts not held) lifts the light sheet "
-    "back, which the next self-collision pass pushes down again under the heavy pads, and the "
-    "limiter stops at its iteration cap with edges left over (4,683 edge-substeps in 150 "
-    "frames). Holding the pads needs the self-contacts inside the limiter's iteration (the pad "
-    "and the sheet under it moved together), which the engine does not do";
-
 TEST(StressContact, HeavyObjectsDroppedOnASheetPinnedAtItsCorners) {
   constexpr Index kSheet = 15, kPad = 4;
   TriangleMesh mesh;
@@ -241,8 +236,12 @@ TEST(StressContact, HeavyObjectsDroppedOnASheetPinnedAtItsCorners) {
               x[firstPad].y(), x[secondPad].y(), lowestSheet);
   EXPECT_GT(x[firstPad].y(), lowestSheet);
   EXPECT_GT(x[secondPad].y(), lowestSheet);
-  monitor.expectPasses("heavy_objects_on_sheet", kCottonStrainLimit,
-                       {{StressMonitor::Condition::Strain, kHeavyReason}});
+  // Max strain 0.103 (8.1 before the self-contacts were held inside the limiter; 32 when the
+  // limiter ran only before the collisions, 45 without it). The pads touch the sheet only through
+  // the self-collision, which hands their momentum to the light sheet vertices under them; the
+  // limiter run after it holds those pairs apart (StrainLimiter::applyInContact, `separations`)
+  // with both sides counting as heavy as the pad, so lifting the sheet lifts the pads with it.
+  monitor.expectPasses("heavy_objects_on_sheet", kCottonStrainLimit);
 }
 
 }  // namespace
