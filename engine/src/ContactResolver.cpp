@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 namespace weft {
@@ -66,6 +67,7 @@ void ContactResolver::setTopology(std::vector<std::array<Index, 3>> triangles,
   m_edges = std::move(edges);
   m_rest = std::move(rest);
   m_owner = std::move(owners);
+  m_proximityCached = false;
   m_zoneParent.resize(m_rest.size());
   // Triangles around every vertex (ascending) and the one or two triangles of every edge.
   const Index vertexCount = Index(m_rest.size());
@@ -334,9 +336,9 @@ void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpee
   }
 }
 
-void ContactResolver::holdContacts() {
+void ContactResolver::holdContacts(const std::vector<Contact>& contacts) {
   if (!m_recordSeparations) return;
-  for (const Contact& contact : m_contacts) {
+  for (const Contact& contact : contacts) {
     m_separationHolds.push_back(SeparationHold{contact.vertices, contact.weights, contact.normal,
                                                contact.thickness});
   }
@@ -443,6 +445,80 @@ void ContactResolver::rigidifyZones(const Vec3Array& start, const std::vector<Re
   }
 }
 
+bool ContactResolver::proximityCacheMatches(const Vec3Array& start,
+                                            std::span<const ContactOwner> owners) const {
+  if (!m_proximityCached || start.size() != m_proximityStart.size() ||
+      owners.size() != m_proximityOwners.size()) {
+    return false;
+  }
+  // Bit for bit (memcmp: −0 and +0 differ, NaN never matches itself), the strictest test.
+  if (std::memcmp(start.data(), m_proximityStart.data(), start.size() * sizeof(Vec3)) != 0) return false;
+  for (std::size_t k = 0; k < owners.size(); ++k) {
+    if (std::memcmp(&owners[k].thickness, &m_proximityOwners[k].thickness, sizeof(Real)) != 0 ||
+        std::memcmp(&owners[k].friction, &m_proximityOwners[k].friction, sizeof(Real)) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void ContactResolver::findProximityContacts(const Vec3Array& start, Real maxThickness) {
+  findTrianglePairs(start, start, maxThickness, true, m_trianglePairs);
+  collectFeaturePairs(start, start, maxThickness);
+  const Index vertexTriangleCount = Index(m_vertexTriangle.size());
+  // The exact distance tests, in parallel: they read only x₀ and the rest shape.
+  findContacts([&](Index pair, Contact& contact) {
+    if (pair < vertexTriangleCount) {
+      const auto& [vertex, triangle] = m_vertexTriangle[pair];
+      const std::array<Index, 3>& c = m_triangles[triangle];
+      Real thickness, friction;
+      pairParameters(vertex, c[0], thickness, friction);
+      const TriangleClosestPoint closest =
+          closestPointOnTriangle(start[vertex], start[c[0]], start[c[1]], start[c[2]]);
+      if (closest.distance >= thickness) return false;
+      // Features that are this close in the rest shape are neighbours in the material (a mesh
+      // finer than the thickness): the elastic forces keep them apart, repulsion would fight
+      // them.
+      if (m_owner[vertex] == m_owner[c[0]] &&
+          closestPointOnTriangle(m_rest[vertex], m_rest[c[0]], m_rest[c[1]], m_rest[c[2]]).distance <
+              thickness) {
+        return false;
+      }
+      Vec3 normal = start[vertex] - closest.point;
+      if (closest.distance < 1e-9 * thickness) {
+        normal = (start[c[1]] - start[c[0]]).cross(start[c[2]] - start[c[0]]);
+      }
+      if (normal.norm() == 0) return false;
+      contact = {{vertex, c[0], c[1], c[2]},
+                 {1, -closest.barycentric[0], -closest.barycentric[1], -closest.barycentric[2]},
+                 normal.normalized(), closest.distance, thickness, friction};
+      return true;
+    }
+    const auto& [firstEdge, secondEdge] = m_edgeEdge[pair - vertexTriangleCount];
+    const std::array<Index, 2>& p = m_edges[firstEdge];
+    const std::array<Index, 2>& q = m_edges[secondEdge];
+    Real thickness, friction;
+    pairParameters(p[0], q[0], thickness, friction);
+    const SegmentClosestPoints closest =
+        closestPointsOnSegments(start[p[0]], start[p[1]], start[q[0]], start[q[1]]);
+    if (closest.distance >= thickness) return false;
+    if (m_owner[p[0]] == m_owner[q[0]] &&
+        closestPointsOnSegments(m_rest[p[0]], m_rest[p[1]], m_rest[q[0]], m_rest[q[1]]).distance <
+            thickness) {
+      return false;  // neighbours in the material, as above
+    }
+    const Real s = closest.firstParameter, u = closest.secondParameter;
+    Vec3 normal = ((1 - s) * start[p[0]] + s * start[p[1]]) - ((1 - u) * start[q[0]] + u * start[q[1]]);
+    if (closest.distance < 1e-9 * thickness) {
+      normal = (start[p[1]] - start[p[0]]).cross(start[q[1]] - start[q[0]]);
+    }
+    if (normal.norm() == 0) return false;
+    contact = {{p[0], p[1], q[0], q[1]}, {1 - s, s, -(1 - u), -u}, normal.normalized(),
+               closest.distance, thickness, friction};
+    return true;
+  });
+}
+
 SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
                                              std::span<const ContactOwner> owners,
                                              const std::vector<Real>& inverseMasses,
@@ -463,71 +539,30 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
 
   // 1. Proximity at the step start: repulsion, inelastic contact and friction.
   if (options.proximity) {
-    findTrianglePairs(start, start, maxThickness, true, m_trianglePairs);
-    collectFeaturePairs(start, start, maxThickness);
-    const Index vertexTriangleCount = Index(m_vertexTriangle.size());
-    // The exact distance tests, in parallel: they read only x₀ and the rest shape.
-    findContacts([&](Index pair, Contact& contact) {
-      if (pair < vertexTriangleCount) {
-        const auto& [vertex, triangle] = m_vertexTriangle[pair];
-        const std::array<Index, 3>& c = m_triangles[triangle];
-        Real thickness, friction;
-        pairParameters(vertex, c[0], thickness, friction);
-        const TriangleClosestPoint closest =
-            closestPointOnTriangle(start[vertex], start[c[0]], start[c[1]], start[c[2]]);
-        if (closest.distance >= thickness) return false;
-        // Features that are this close in the rest shape are neighbours in the material (a mesh
-        // finer than the thickness): the elastic forces keep them apart, repulsion would fight
-        // them.
-        if (m_owner[vertex] == m_owner[c[0]] &&
-            closestPointOnTriangle(m_rest[vertex], m_rest[c[0]], m_rest[c[1]], m_rest[c[2]]).distance <
-                thickness) {
-          return false;
-        }
-        Vec3 normal = start[vertex] - closest.point;
-        if (closest.distance < 1e-9 * thickness) {
-          normal = (start[c[1]] - start[c[0]]).cross(start[c[2]] - start[c[0]]);
-        }
-        if (normal.norm() == 0) return false;
-        contact = {{vertex, c[0], c[1], c[2]},
-                   {1, -closest.barycentric[0], -closest.barycentric[1], -closest.barycentric[2]},
-                   normal.normalized(), closest.distance, thickness, friction};
-        return true;
+    const std::vector<Contact>* proximity = &m_contacts;
+    if (!m_reuseProximity) {
+      findProximityContacts(start, maxThickness);
+    } else {
+      if (!proximityCacheMatches(start, owners)) {
+        findProximityContacts(start, maxThickness);
+        m_proximityContacts = m_contacts;
+        m_proximityStart = start;
+        m_proximityOwners.assign(owners.begin(), owners.end());
+        m_proximityCached = true;
       }
-      const auto& [firstEdge, secondEdge] = m_edgeEdge[pair - vertexTriangleCount];
-      const std::array<Index, 2>& p = m_edges[firstEdge];
-      const std::array<Index, 2>& q = m_edges[secondEdge];
-      Real thickness, friction;
-      pairParameters(p[0], q[0], thickness, friction);
-      const SegmentClosestPoints closest =
-          closestPointsOnSegments(start[p[0]], start[p[1]], start[q[0]], start[q[1]]);
-      if (closest.distance >= thickness) return false;
-      if (m_owner[p[0]] == m_owner[q[0]] &&
-          closestPointsOnSegments(m_rest[p[0]], m_rest[p[1]], m_rest[q[0]], m_rest[q[1]]).distance <
-              thickness) {
-        return false;  // neighbours in the material, as above
-      }
-      const Real s = closest.firstParameter, u = closest.secondParameter;
-      Vec3 normal = ((1 - s) * start[p[0]] + s * start[p[1]]) - ((1 - u) * start[q[0]] + u * start[q[1]]);
-      if (closest.distance < 1e-9 * thickness) {
-        normal = (start[p[1]] - start[p[0]]).cross(start[q[1]] - start[q[0]]);
-      }
-      if (normal.norm() == 0) return false;
-      contact = {{p[0], p[1], q[0], q[1]}, {1 - s, s, -(1 - u), -u}, normal.normalized(),
-                 closest.distance, thickness, friction};
-      return true;
-    });
+      proximity = &m_proximityContacts;
+    }
     // The impulses, one after the other in pair order (Gauss–Seidel).
     WEFT_PROFILE_ZONE("response");
     const int sweeps = m_colliders.empty() ? 1 : kProximitySweepsWithColliders;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
-      for (const Contact& contact : m_contacts) {
+      for (const Contact& contact : *proximity) {
         applyImpulse(contact, kRepulsionRate * (contact.thickness - contact.gap) / h, inverseMasses);
       }
       clampToColliders(start, h);
     }
-    report.proximityContacts += Index(m_contacts.size());
-    holdContacts();
+    report.proximityContacts += Index(proximity->size());
+    holdContacts(*proximity);
   }
 
   // 2. Continuous detection of the corrected motion, impulses until clean (bounded).
@@ -540,7 +575,7 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
       applyImpulse(contact, kImpactSeparation * contact.thickness / h, inverseMasses);
       ++report.impacts;
     }
-    holdContacts();
+    holdContacts(m_contacts);
     clampToColliders(start, h);
   }
 

@@ -135,6 +135,16 @@ class ContactResolver {
   virtual void findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate,
                                  bool proximity, std::vector<TrianglePair>& pairs) = 0;
 
+  /// For a subclass whose proximity broad phase (findTrianglePairs with `proximity`) depends on
+  /// nothing but its arguments: resolve() may then keep the proximity contacts it found and
+  /// reuse them while the step start and the owners stay the same, bit for bit (the rounds of
+  /// Cloth::limitStrainInContact resolve the same step again). The detection reads only x₀, the
+  /// rest shape and the owners, so the reused list is the one it would find again.
+  void setProximityReuse(bool reuse) {
+    m_reuseProximity = reuse;
+    m_proximityCached = false;
+  }
+
   TaskSystem* m_tasks = nullptr;
 
  private:
@@ -174,9 +184,14 @@ class ContactResolver {
   // After a round of impulses: corrected vertices whose step ends within the thickness of a
   // collider go back onto it.
   void clampToColliders(const Vec3Array& start, Real h);
-  // Appends the pairs of m_contacts to m_separationHolds (their separations are set at the end
+  // Appends the pairs of `contacts` to m_separationHolds (their separations are set at the end
   // of resolve()).
-  void holdContacts();
+  void holdContacts(const std::vector<Contact>& contacts);
+  // The proximity stage's detection: its contacts into m_contacts.
+  void findProximityContacts(const Vec3Array& start, Real maxThickness);
+  // True when the proximity contacts kept from an earlier resolve() are those of `start` and
+  // `owners` (see setProximityReuse).
+  bool proximityCacheMatches(const Vec3Array& start, std::span<const ContactOwner> owners) const;
 
   std::vector<std::array<Index, 3>> m_triangles;      // vertex ids of each triangle
   std::vector<std::array<Index, 3>> m_triangleEdges;  // edge ids of each triangle
@@ -207,6 +222,13 @@ class ContactResolver {
   std::vector<char> m_touched;      // 1 for vertices whose velocity this resolve changed
   std::vector<SeparationHold> m_separationHolds;  // see separationHolds()
   bool m_recordSeparations = false;
+  // Proximity contacts kept for reuse (setProximityReuse), with the step start and owners they
+  // were found for.
+  bool m_reuseProximity = false;
+  bool m_proximityCached = false;
+  Vec3Array m_proximityStart;
+  std::vector<ContactOwner> m_proximityOwners;
+  std::vector<Contact> m_proximityContacts;
 };
 
 }  // namespace weft

@@ -37,6 +37,8 @@ SelfCollision::SelfCollision(const ClothModel& model, TaskSystem* tasks) : Conta
   buildEdgeTables(model, edges, triangleEdges);
   setTopology(std::move(triangles), std::move(triangleEdges), std::move(edges),
               model.restPositions(), std::vector<Index>(model.vertexCount(), 0));
+  // The proximity broad phase below reads nothing but its arguments.
+  setProximityReuse(true);
 }
 
 void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate,
