@@ -68,6 +68,7 @@ void ContactResolver::setTopology(std::vector<std::array<Index, 3>> triangles,
   m_rest = std::move(rest);
   m_owner = std::move(owners);
   m_proximityCached = false;
+  m_certificateValid = false;
   m_zoneParent.resize(m_rest.size());
   // Triangles around every vertex (ascending) and the one or two triangles of every edge.
   const Index vertexCount = Index(m_rest.size());
@@ -113,7 +114,17 @@ bool ContactResolver::sharesVertex(Index first, Index second) const {
   return false;
 }
 
-void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin) {
+void ContactResolver::findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to,
+                                                Real inflate, const std::vector<char>& marked,
+                                                std::vector<TrianglePair>& pairs) {
+  findTrianglePairs(from, to, inflate, false, pairs);
+  std::erase_if(pairs, [&](const TrianglePair& pair) {
+    return !marked[pair.first] && !marked[pair.second];
+  });
+}
+
+void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin,
+                                          const std::vector<char>* dirty) {
   WEFT_PROFILE_ZONE("feature pairs");
   // Every vertex's box over the step, once, instead of once per triangle pair it is in.
   const Index vertexCount = Index(from.size());
@@ -162,6 +173,10 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
     }
     return best;
   };
+  auto touchesDirty = [&](Index vertex, const std::array<Index, 3>& triangle) {
+    return !dirty || (*dirty)[vertex] || (*dirty)[triangle[0]] || (*dirty)[triangle[1]] ||
+           (*dirty)[triangle[2]];
+  };
   auto collect = [&](Index begin, Index end, std::vector<std::array<Index, 2>>& vertexTriangle,
                      std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
@@ -171,14 +186,16 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
       for (Index vertex : m_triangles[pair.first]) {
         Aabb box = m_vertexBoxes[vertex];
         box.inflate(margin);
-        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first) {
+        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first &&
+            touchesDirty(vertex, m_triangles[pair.second])) {
           vertexTriangle.push_back({vertex, pair.second});
         }
       }
       for (Index vertex : m_triangles[pair.second]) {
         Aabb box = m_vertexBoxes[vertex];
         box.inflate(margin);
-        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second) {
+        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second &&
+            touchesDirty(vertex, m_triangles[pair.first])) {
           vertexTriangle.push_back({vertex, pair.first});
         }
       }
@@ -189,7 +206,9 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
         first.inflate(margin);
         if (!first.overlaps(secondBox)) continue;
         for (Index b : m_triangleEdges[pair.second]) {
-          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair) {
+          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair &&
+              (!dirty || (*dirty)[m_edges[a][0]] || (*dirty)[m_edges[a][1]] ||
+               (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]])) {
             edgeEdge.push_back({std::min(a, b), std::max(a, b)});
           }
         }
@@ -347,8 +366,31 @@ void ContactResolver::holdContacts(const std::vector<Contact>& contacts) {
 bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
   for (std::size_t i = 0; i < start.size(); ++i) m_end[i] = start[i] + h * m_velocity[i];
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
-  findTrianglePairs(start, m_end, 2 * kDefaultContactTolerance, false, m_trianglePairs);
-  collectFeaturePairs(start, m_end, 2 * kDefaultContactTolerance);
+  const Real inflate = 2 * kDefaultContactTolerance;
+  if (m_certificateUsable) {
+    // Only pairs with a vertex whose end moved since the last clean test can have an impact
+    // (setBroadPhaseIsPure); the others would test exactly as then, and found nothing.
+    Index dirtyCount = 0;
+    m_dirtyVertex.assign(start.size(), 0);
+    for (std::size_t i = 0; i < start.size(); ++i) {
+      if (std::memcmp(&m_end[i], &m_certificateEnd[i], sizeof(Vec3)) != 0) {
+        m_dirtyVertex[i] = 1;
+        ++dirtyCount;
+      }
+    }
+    m_contacts.clear();
+    if (dirtyCount == 0) return false;
+    m_dirtyTriangle.assign(m_triangles.size(), 0);
+    for (Index t = 0; t < m_triangles.size(); ++t) {
+      const std::array<Index, 3>& c = m_triangles[t];
+      m_dirtyTriangle[t] = m_dirtyVertex[c[0]] | m_dirtyVertex[c[1]] | m_dirtyVertex[c[2]];
+    }
+    findTrianglePairsTouching(start, m_end, inflate, m_dirtyTriangle, m_trianglePairs);
+    collectFeaturePairs(start, m_end, inflate, &m_dirtyVertex);
+  } else {
+    findTrianglePairs(start, m_end, inflate, false, m_trianglePairs);
+    collectFeaturePairs(start, m_end, inflate);
+  }
   const Index vertexTriangleCount = Index(m_vertexTriangle.size());
   findContacts([&](Index pair, Contact& contact) {
     if (pair < vertexTriangleCount) {
@@ -394,7 +436,14 @@ bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
     pairParameters(p[0], q[0], contact.thickness, contact.friction);
     return true;
   });
-  return !m_contacts.empty();
+  if (!m_contacts.empty()) return true;
+  if (m_broadPhaseIsPure) {
+    // Nothing collides along start → m_end: the certificate for the next tests of this start.
+    if (!m_certificateUsable) m_certificateStart = start;
+    m_certificateEnd = m_end;
+    m_certificateValid = m_certificateUsable = true;
+  }
+  return false;
 }
 
 void ContactResolver::rigidifyZones(const Vec3Array& start, const std::vector<Real>& inverseMasses) {
@@ -533,6 +582,9 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
   m_separationHolds.clear();
   if (!m_colliders.empty()) m_held.assign(n, -1);
   m_stepEnd = &x;
+  m_certificateUsable = m_broadPhaseIsPure && m_certificateValid &&
+                        m_certificateStart.size() == n &&
+                        std::memcmp(start.data(), m_certificateStart.data(), n * sizeof(Vec3)) == 0;
   for (std::size_t i = 0; i < n; ++i) m_velocity[i] = (x[i] - start[i]) / h;
   Real maxThickness = 0;
   for (const ContactOwner& owner : owners) maxThickness = std::max(maxThickness, owner.thickness);
@@ -540,7 +592,7 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
   // 1. Proximity at the step start: repulsion, inelastic contact and friction.
   if (options.proximity) {
     const std::vector<Contact>* proximity = &m_contacts;
-    if (!m_reuseProximity) {
+    if (!m_broadPhaseIsPure) {
       findProximityContacts(start, maxThickness);
     } else {
       if (!proximityCacheMatches(start, owners)) {

@@ -134,15 +134,28 @@ class ContactResolver {
   /// some pairs).
   virtual void findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate,
                                  bool proximity, std::vector<TrianglePair>& pairs) = 0;
+  /// The swept stage's findTrianglePairs restricted to pairs with a triangle whose flag in
+  /// `marked` (per triangle) is set: clears `pairs`, then writes, sorted and each once, at least
+  /// every such pair findTrianglePairs(from, to, inflate, false) would write (more is allowed: a
+  /// pair whose boxes do not overlap yields no feature pair). This one filters the full list.
+  virtual void findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to, Real inflate,
+                                         const std::vector<char>& marked,
+                                         std::vector<TrianglePair>& pairs);
 
-  /// For a subclass whose proximity broad phase (findTrianglePairs with `proximity`) depends on
-  /// nothing but its arguments: resolve() may then keep the proximity contacts it found and
-  /// reuse them while the step start and the owners stay the same, bit for bit (the rounds of
-  /// Cloth::limitStrainInContact resolve the same step again). The detection reads only x₀, the
-  /// rest shape and the owners, so the reused list is the one it would find again.
-  void setProximityReuse(bool reuse) {
-    m_reuseProximity = reuse;
+  /// For a subclass whose broad phase (findTrianglePairs) depends on nothing but its arguments:
+  /// resolve() may then carry what it learnt about one step into the next resolve() of the same
+  /// step start (bit for bit; the rounds of Cloth::limitStrainInContact resolve the same step
+  /// again after the limiter moved some vertices), with the same results as without:
+  ///  - the proximity contacts, found from x₀, the rest shape and the owners only, are kept and
+  ///    reused while x₀ and the owners are unchanged;
+  ///  - the end positions of the last swept test that found nothing are kept as a certificate:
+  ///    a feature pair whose four vertices have bit for bit the same start and end as then has
+  ///    no impact now either, so the swept tests run only over pairs with a vertex whose end
+  ///    differs (findTrianglePairsTouching). The contacts found are the same, in the same order.
+  void setBroadPhaseIsPure(bool pure) {
+    m_broadPhaseIsPure = pure;
     m_proximityCached = false;
+    m_certificateValid = false;
   }
 
   TaskSystem* m_tasks = nullptr;
@@ -168,7 +181,9 @@ class ContactResolver {
   // Vertex–triangle and edge–edge pairs of the candidate triangle pairs whose own boxes (over
   // positions `from` and `to`, one side inflated by `margin`) overlap; each once, in the order
   // of the triangle pairs.
-  void collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin);
+  // With `dirty` (per vertex), only the feature pairs with a dirty vertex.
+  void collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin,
+                           const std::vector<char>* dirty = nullptr);
   bool sharesVertex(Index firstTriangle, Index secondTriangle) const;
   // Runs test(pairIndex, contact) -> bool over every feature pair (vertex–triangle first, then
   // edge–edge) in parallel and leaves the contacts it accepted in m_contacts, in pair order.
@@ -190,7 +205,7 @@ class ContactResolver {
   // The proximity stage's detection: its contacts into m_contacts.
   void findProximityContacts(const Vec3Array& start, Real maxThickness);
   // True when the proximity contacts kept from an earlier resolve() are those of `start` and
-  // `owners` (see setProximityReuse).
+  // `owners` (see setBroadPhaseIsPure).
   bool proximityCacheMatches(const Vec3Array& start, std::span<const ContactOwner> owners) const;
 
   std::vector<std::array<Index, 3>> m_triangles;      // vertex ids of each triangle
@@ -222,13 +237,19 @@ class ContactResolver {
   std::vector<char> m_touched;      // 1 for vertices whose velocity this resolve changed
   std::vector<SeparationHold> m_separationHolds;  // see separationHolds()
   bool m_recordSeparations = false;
-  // Proximity contacts kept for reuse (setProximityReuse), with the step start and owners they
+  // Proximity contacts kept for reuse (setBroadPhaseIsPure), with the step start and owners they
   // were found for.
-  bool m_reuseProximity = false;
+  bool m_broadPhaseIsPure = false;
   bool m_proximityCached = false;
   Vec3Array m_proximityStart;
   std::vector<ContactOwner> m_proximityOwners;
   std::vector<Contact> m_proximityContacts;
+  // The swept certificate (setBroadPhaseIsPure): the step start and end positions of the last
+  // swept test that found no contact; m_certificateUsable: valid for the resolve() under way.
+  bool m_certificateValid = false;
+  bool m_certificateUsable = false;
+  Vec3Array m_certificateStart, m_certificateEnd;
+  std::vector<char> m_dirtyVertex, m_dirtyTriangle;  // end differs from the certificate's
 };
 
 }  // namespace weft
