@@ -368,12 +368,13 @@ bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
   const Real inflate = 2 * kDefaultContactTolerance;
   if (m_certificateUsable) {
-    // Only pairs with a vertex whose end moved since the last clean test can have an impact
-    // (setBroadPhaseIsPure); the others would test exactly as then, and found nothing.
+    // Only pairs with a vertex whose end moved since the last test, or that was in one of its
+    // contacts, can test positive (setBroadPhaseIsPure); the others would test exactly as then,
+    // negative.
     Index dirtyCount = 0;
     m_dirtyVertex.assign(start.size(), 0);
     for (std::size_t i = 0; i < start.size(); ++i) {
-      if (std::memcmp(&m_end[i], &m_certificateEnd[i], sizeof(Vec3)) != 0) {
+      if (m_certificateForced[i] || std::memcmp(&m_end[i], &m_certificateEnd[i], sizeof(Vec3)) != 0) {
         m_dirtyVertex[i] = 1;
         ++dirtyCount;
       }
@@ -436,14 +437,18 @@ bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
     pairParameters(p[0], q[0], contact.thickness, contact.friction);
     return true;
   });
-  if (!m_contacts.empty()) return true;
   if (m_broadPhaseIsPure) {
-    // Nothing collides along start → m_end: the certificate for the next tests of this start.
+    // Every pair outside m_contacts tests negative along start → m_end: the certificate for the
+    // next tests of this start, with the vertices of the contacts always tested again.
     if (!m_certificateUsable) m_certificateStart = start;
     m_certificateEnd = m_end;
+    m_certificateForced.assign(start.size(), 0);
+    for (const Contact& contact : m_contacts) {
+      for (Index vertex : contact.vertices) m_certificateForced[vertex] = 1;
+    }
     m_certificateValid = m_certificateUsable = true;
   }
-  return false;
+  return !m_contacts.empty();
 }
 
 void ContactResolver::rigidifyZones(const Vec3Array& start, const std::vector<Real>& inverseMasses) {

@@ -148,10 +148,12 @@ class ContactResolver {
   /// again after the limiter moved some vertices), with the same results as without:
   ///  - the proximity contacts, found from x₀, the rest shape and the owners only, are kept and
   ///    reused while x₀ and the owners are unchanged;
-  ///  - the end positions of the last swept test that found nothing are kept as a certificate:
-  ///    a feature pair whose four vertices have bit for bit the same start and end as then has
-  ///    no impact now either, so the swept tests run only over pairs with a vertex whose end
-  ///    differs (findTrianglePairsTouching). The contacts found are the same, in the same order.
+  ///  - the end positions of the last swept test are kept as a certificate, with the vertices
+  ///    of the contacts it found: a feature pair of none of those vertices whose four vertices
+  ///    have bit for bit the same start and end as then tests negative now too (it did then), so
+  ///    the later swept tests of the same start (the next impulse passes, the impact zones, the
+  ///    next resolve()) run only over pairs with a vertex whose end differs or that was in a
+  ///    contact (findTrianglePairsTouching). The contacts found are the same, in the same order.
   void setBroadPhaseIsPure(bool pure) {
     m_broadPhaseIsPure = pure;
     m_proximityCached = false;
@@ -245,10 +247,12 @@ class ContactResolver {
   std::vector<ContactOwner> m_proximityOwners;
   std::vector<Contact> m_proximityContacts;
   // The swept certificate (setBroadPhaseIsPure): the step start and end positions of the last
-  // swept test that found no contact; m_certificateUsable: valid for the resolve() under way.
+  // swept test, and 1 for the vertices of the contacts it found; m_certificateUsable: valid for
+  // the resolve() under way.
   bool m_certificateValid = false;
   bool m_certificateUsable = false;
   Vec3Array m_certificateStart, m_certificateEnd;
+  std::vector<char> m_certificateForced;
   std::vector<char> m_dirtyVertex, m_dirtyTriangle;  // end differs from the certificate's
 };
 
