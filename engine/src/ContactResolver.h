@@ -41,6 +41,15 @@
 // (c) the proximity impulses are swept a few times, so that what the clamp took from one side
 // of a pair goes to the other. The last-resort freeze keeps x₀, which was outside.
 //
+// Resolving one step again. Cloth::limitStrainInContact resolves the same step (same x₀) up to
+// six more times after the strain limiter moved some vertices. For SelfCollision (whose broad
+// phase reads only its arguments: setBroadPhaseIsPure) such a resolve reuses the proximity
+// contacts (they depend on x₀ only) and runs the swept tests only over feature pairs with a
+// vertex whose end differs, bit for bit, from the last swept test of that x₀ or that was in one
+// of its contacts: every other pair would test exactly as then, negative. Same contacts in the
+// same order, so the same bits; on the curtain this took the rounds' self-collision passes from
+// ~1.6 ms to ~0.2 ms during the sphere's push (one thread, shared machine).
+//
 // Owners. Every vertex belongs to an owner (a cloth) with its own thickness and friction. A pair
 // uses the larger thickness of its two owners and the geometric mean of their frictions (one
 // owner: its own values, bit for bit). Features closer than the thickness in the rest shape are
