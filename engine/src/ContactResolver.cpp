@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 
 namespace weft {
@@ -66,6 +67,8 @@ void ContactResolver::setTopology(std::vector<std::array<Index, 3>> triangles,
   m_edges = std::move(edges);
   m_rest = std::move(rest);
   m_owner = std::move(owners);
+  m_proximityCached = false;
+  m_certificateValid = false;
   m_zoneParent.resize(m_rest.size());
   // Triangles around every vertex (ascending) and the one or two triangles of every edge.
   const Index vertexCount = Index(m_rest.size());
@@ -111,7 +114,17 @@ bool ContactResolver::sharesVertex(Index first, Index second) const {
   return false;
 }
 
-void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin) {
+void ContactResolver::findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to,
+                                                Real inflate, const std::vector<char>& marked,
+                                                std::vector<TrianglePair>& pairs) {
+  findTrianglePairs(from, to, inflate, false, pairs);
+  std::erase_if(pairs, [&](const TrianglePair& pair) {
+    return !marked[pair.first] && !marked[pair.second];
+  });
+}
+
+void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin,
+                                          const std::vector<char>* dirty) {
   WEFT_PROFILE_ZONE("feature pairs");
   // Every vertex's box over the step, once, instead of once per triangle pair it is in.
   const Index vertexCount = Index(from.size());
@@ -160,6 +173,10 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
     }
     return best;
   };
+  auto touchesDirty = [&](Index vertex, const std::array<Index, 3>& triangle) {
+    return !dirty || (*dirty)[vertex] || (*dirty)[triangle[0]] || (*dirty)[triangle[1]] ||
+           (*dirty)[triangle[2]];
+  };
   auto collect = [&](Index begin, Index end, std::vector<std::array<Index, 2>>& vertexTriangle,
                      std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
@@ -169,14 +186,16 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
       for (Index vertex : m_triangles[pair.first]) {
         Aabb box = m_vertexBoxes[vertex];
         box.inflate(margin);
-        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first) {
+        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first &&
+            touchesDirty(vertex, m_triangles[pair.second])) {
           vertexTriangle.push_back({vertex, pair.second});
         }
       }
       for (Index vertex : m_triangles[pair.second]) {
         Aabb box = m_vertexBoxes[vertex];
         box.inflate(margin);
-        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second) {
+        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second &&
+            touchesDirty(vertex, m_triangles[pair.first])) {
           vertexTriangle.push_back({vertex, pair.first});
         }
       }
@@ -187,7 +206,9 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
         first.inflate(margin);
         if (!first.overlaps(secondBox)) continue;
         for (Index b : m_triangleEdges[pair.second]) {
-          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair) {
+          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair &&
+              (!dirty || (*dirty)[m_edges[a][0]] || (*dirty)[m_edges[a][1]] ||
+               (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]])) {
             edgeEdge.push_back({std::min(a, b), std::max(a, b)});
           }
         }
@@ -334,9 +355,9 @@ void ContactResolver::applyImpulse(const Contact& contact, Real targetNormalSpee
   }
 }
 
-void ContactResolver::holdContacts() {
+void ContactResolver::holdContacts(const std::vector<Contact>& contacts) {
   if (!m_recordSeparations) return;
-  for (const Contact& contact : m_contacts) {
+  for (const Contact& contact : contacts) {
     m_separationHolds.push_back(SeparationHold{contact.vertices, contact.weights, contact.normal,
                                                contact.thickness});
   }
@@ -345,8 +366,32 @@ void ContactResolver::holdContacts() {
 bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
   for (std::size_t i = 0; i < start.size(); ++i) m_end[i] = start[i] + h * m_velocity[i];
   // The CCD tolerance is 1 µm: boxes inflated by a little more catch every contact it reports.
-  findTrianglePairs(start, m_end, 2 * kDefaultContactTolerance, false, m_trianglePairs);
-  collectFeaturePairs(start, m_end, 2 * kDefaultContactTolerance);
+  const Real inflate = 2 * kDefaultContactTolerance;
+  if (m_certificateUsable) {
+    // Only pairs with a vertex whose end moved since the last test, or that was in one of its
+    // contacts, can test positive (setBroadPhaseIsPure); the others would test exactly as then,
+    // negative.
+    Index dirtyCount = 0;
+    m_dirtyVertex.assign(start.size(), 0);
+    for (std::size_t i = 0; i < start.size(); ++i) {
+      if (m_certificateForced[i] || std::memcmp(&m_end[i], &m_certificateEnd[i], sizeof(Vec3)) != 0) {
+        m_dirtyVertex[i] = 1;
+        ++dirtyCount;
+      }
+    }
+    m_contacts.clear();
+    if (dirtyCount == 0) return false;
+    m_dirtyTriangle.assign(m_triangles.size(), 0);
+    for (Index t = 0; t < m_triangles.size(); ++t) {
+      const std::array<Index, 3>& c = m_triangles[t];
+      m_dirtyTriangle[t] = m_dirtyVertex[c[0]] | m_dirtyVertex[c[1]] | m_dirtyVertex[c[2]];
+    }
+    findTrianglePairsTouching(start, m_end, inflate, m_dirtyTriangle, m_trianglePairs);
+    collectFeaturePairs(start, m_end, inflate, &m_dirtyVertex);
+  } else {
+    findTrianglePairs(start, m_end, inflate, false, m_trianglePairs);
+    collectFeaturePairs(start, m_end, inflate);
+  }
   const Index vertexTriangleCount = Index(m_vertexTriangle.size());
   findContacts([&](Index pair, Contact& contact) {
     if (pair < vertexTriangleCount) {
@@ -392,6 +437,17 @@ bool ContactResolver::findImpacts(const Vec3Array& start, Real h) {
     pairParameters(p[0], q[0], contact.thickness, contact.friction);
     return true;
   });
+  if (m_broadPhaseIsPure) {
+    // Every pair outside m_contacts tests negative along start → m_end: the certificate for the
+    // next tests of this start, with the vertices of the contacts always tested again.
+    if (!m_certificateUsable) m_certificateStart = start;
+    m_certificateEnd = m_end;
+    m_certificateForced.assign(start.size(), 0);
+    for (const Contact& contact : m_contacts) {
+      for (Index vertex : contact.vertices) m_certificateForced[vertex] = 1;
+    }
+    m_certificateValid = m_certificateUsable = true;
+  }
   return !m_contacts.empty();
 }
 
@@ -443,6 +499,80 @@ void ContactResolver::rigidifyZones(const Vec3Array& start, const std::vector<Re
   }
 }
 
+bool ContactResolver::proximityCacheMatches(const Vec3Array& start,
+                                            std::span<const ContactOwner> owners) const {
+  if (!m_proximityCached || start.size() != m_proximityStart.size() ||
+      owners.size() != m_proximityOwners.size()) {
+    return false;
+  }
+  // Bit for bit (memcmp: −0 and +0 differ, NaN never matches itself), the strictest test.
+  if (std::memcmp(start.data(), m_proximityStart.data(), start.size() * sizeof(Vec3)) != 0) return false;
+  for (std::size_t k = 0; k < owners.size(); ++k) {
+    if (std::memcmp(&owners[k].thickness, &m_proximityOwners[k].thickness, sizeof(Real)) != 0 ||
+        std::memcmp(&owners[k].friction, &m_proximityOwners[k].friction, sizeof(Real)) != 0) {
+      return false;
+    }
+  }
+  return true;
+}
+
+void ContactResolver::findProximityContacts(const Vec3Array& start, Real maxThickness) {
+  findTrianglePairs(start, start, maxThickness, true, m_trianglePairs);
+  collectFeaturePairs(start, start, maxThickness);
+  const Index vertexTriangleCount = Index(m_vertexTriangle.size());
+  // The exact distance tests, in parallel: they read only x₀ and the rest shape.
+  findContacts([&](Index pair, Contact& contact) {
+    if (pair < vertexTriangleCount) {
+      const auto& [vertex, triangle] = m_vertexTriangle[pair];
+      const std::array<Index, 3>& c = m_triangles[triangle];
+      Real thickness, friction;
+      pairParameters(vertex, c[0], thickness, friction);
+      const TriangleClosestPoint closest =
+          closestPointOnTriangle(start[vertex], start[c[0]], start[c[1]], start[c[2]]);
+      if (closest.distance >= thickness) return false;
+      // Features that are this close in the rest shape are neighbours in the material (a mesh
+      // finer than the thickness): the elastic forces keep them apart, repulsion would fight
+      // them.
+      if (m_owner[vertex] == m_owner[c[0]] &&
+          closestPointOnTriangle(m_rest[vertex], m_rest[c[0]], m_rest[c[1]], m_rest[c[2]]).distance <
+              thickness) {
+        return false;
+      }
+      Vec3 normal = start[vertex] - closest.point;
+      if (closest.distance < 1e-9 * thickness) {
+        normal = (start[c[1]] - start[c[0]]).cross(start[c[2]] - start[c[0]]);
+      }
+      if (normal.norm() == 0) return false;
+      contact = {{vertex, c[0], c[1], c[2]},
+                 {1, -closest.barycentric[0], -closest.barycentric[1], -closest.barycentric[2]},
+                 normal.normalized(), closest.distance, thickness, friction};
+      return true;
+    }
+    const auto& [firstEdge, secondEdge] = m_edgeEdge[pair - vertexTriangleCount];
+    const std::array<Index, 2>& p = m_edges[firstEdge];
+    const std::array<Index, 2>& q = m_edges[secondEdge];
+    Real thickness, friction;
+    pairParameters(p[0], q[0], thickness, friction);
+    const SegmentClosestPoints closest =
+        closestPointsOnSegments(start[p[0]], start[p[1]], start[q[0]], start[q[1]]);
+    if (closest.distance >= thickness) return false;
+    if (m_owner[p[0]] == m_owner[q[0]] &&
+        closestPointsOnSegments(m_rest[p[0]], m_rest[p[1]], m_rest[q[0]], m_rest[q[1]]).distance <
+            thickness) {
+      return false;  // neighbours in the material, as above
+    }
+    const Real s = closest.firstParameter, u = closest.secondParameter;
+    Vec3 normal = ((1 - s) * start[p[0]] + s * start[p[1]]) - ((1 - u) * start[q[0]] + u * start[q[1]]);
+    if (closest.distance < 1e-9 * thickness) {
+      normal = (start[p[1]] - start[p[0]]).cross(start[q[1]] - start[q[0]]);
+    }
+    if (normal.norm() == 0) return false;
+    contact = {{p[0], p[1], q[0], q[1]}, {1 - s, s, -(1 - u), -u}, normal.normalized(),
+               closest.distance, thickness, friction};
+    return true;
+  });
+}
+
 SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
                                              std::span<const ContactOwner> owners,
                                              const std::vector<Real>& inverseMasses,
@@ -457,77 +587,39 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
   m_separationHolds.clear();
   if (!m_colliders.empty()) m_held.assign(n, -1);
   m_stepEnd = &x;
+  m_certificateUsable = m_broadPhaseIsPure && m_certificateValid &&
+                        m_certificateStart.size() == n &&
+                        std::memcmp(start.data(), m_certificateStart.data(), n * sizeof(Vec3)) == 0;
   for (std::size_t i = 0; i < n; ++i) m_velocity[i] = (x[i] - start[i]) / h;
   Real maxThickness = 0;
   for (const ContactOwner& owner : owners) maxThickness = std::max(maxThickness, owner.thickness);
 
   // 1. Proximity at the step start: repulsion, inelastic contact and friction.
   if (options.proximity) {
-    findTrianglePairs(start, start, maxThickness, true, m_trianglePairs);
-    collectFeaturePairs(start, start, maxThickness);
-    const Index vertexTriangleCount = Index(m_vertexTriangle.size());
-    // The exact distance tests, in parallel: they read only x₀ and the rest shape.
-    findContacts([&](Index pair, Contact& contact) {
-      if (pair < vertexTriangleCount) {
-        const auto& [vertex, triangle] = m_vertexTriangle[pair];
-        const std::array<Index, 3>& c = m_triangles[triangle];
-        Real thickness, friction;
-        pairParameters(vertex, c[0], thickness, friction);
-        const TriangleClosestPoint closest =
-            closestPointOnTriangle(start[vertex], start[c[0]], start[c[1]], start[c[2]]);
-        if (closest.distance >= thickness) return false;
-        // Features that are this close in the rest shape are neighbours in the material (a mesh
-        // finer than the thickness): the elastic forces keep them apart, repulsion would fight
-        // them.
-        if (m_owner[vertex] == m_owner[c[0]] &&
-            closestPointOnTriangle(m_rest[vertex], m_rest[c[0]], m_rest[c[1]], m_rest[c[2]]).distance <
-                thickness) {
-          return false;
-        }
-        Vec3 normal = start[vertex] - closest.point;
-        if (closest.distance < 1e-9 * thickness) {
-          normal = (start[c[1]] - start[c[0]]).cross(start[c[2]] - start[c[0]]);
-        }
-        if (normal.norm() == 0) return false;
-        contact = {{vertex, c[0], c[1], c[2]},
-                   {1, -closest.barycentric[0], -closest.barycentric[1], -closest.barycentric[2]},
-                   normal.normalized(), closest.distance, thickness, friction};
-        return true;
+    const std::vector<Contact>* proximity = &m_contacts;
+    if (!m_broadPhaseIsPure) {
+      findProximityContacts(start, maxThickness);
+    } else {
+      if (!proximityCacheMatches(start, owners)) {
+        findProximityContacts(start, maxThickness);
+        m_proximityContacts = m_contacts;
+        m_proximityStart = start;
+        m_proximityOwners.assign(owners.begin(), owners.end());
+        m_proximityCached = true;
       }
-      const auto& [firstEdge, secondEdge] = m_edgeEdge[pair - vertexTriangleCount];
-      const std::array<Index, 2>& p = m_edges[firstEdge];
-      const std::array<Index, 2>& q = m_edges[secondEdge];
-      Real thickness, friction;
-      pairParameters(p[0], q[0], thickness, friction);
-      const SegmentClosestPoints closest =
-          closestPointsOnSegments(start[p[0]], start[p[1]], start[q[0]], start[q[1]]);
-      if (closest.distance >= thickness) return false;
-      if (m_owner[p[0]] == m_owner[q[0]] &&
-          closestPointsOnSegments(m_rest[p[0]], m_rest[p[1]], m_rest[q[0]], m_rest[q[1]]).distance <
-              thickness) {
-        return false;  // neighbours in the material, as above
-      }
-      const Real s = closest.firstParameter, u = closest.secondParameter;
-      Vec3 normal = ((1 - s) * start[p[0]] + s * start[p[1]]) - ((1 - u) * start[q[0]] + u * start[q[1]]);
-      if (closest.distance < 1e-9 * thickness) {
-        normal = (start[p[1]] - start[p[0]]).cross(start[q[1]] - start[q[0]]);
-      }
-      if (normal.norm() == 0) return false;
-      contact = {{p[0], p[1], q[0], q[1]}, {1 - s, s, -(1 - u), -u}, normal.normalized(),
-                 closest.distance, thickness, friction};
-      return true;
-    });
+      proximity = &m_proximityContacts;
+    }
     // The impulses, one after the other in pair order (Gauss–Seidel).
     WEFT_PROFILE_ZONE("response");
     const int sweeps = m_colliders.empty() ? 1 : kProximitySweepsWithColliders;
     for (int sweep = 0; sweep < sweeps; ++sweep) {
-      for (const Contact& contact : m_contacts) {
+      for (const Contact& contact : *proximity) {
         applyImpulse(contact, kRepulsionRate * (contact.thickness - contact.gap) / h, inverseMasses);
       }
       clampToColliders(start, h);
     }
-    report.proximityContacts += Index(m_contacts.size());
-    holdContacts();
+    report.proximityContacts += Index(proximity->size());
+    holdContacts(*proximity);
   }
 
   // 2. Continuous detection of the corrected motion, impulses until clean (bounded).
@@ -540,7 +632,7 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
       applyImpulse(contact, kImpactSeparation * contact.thickness / h, inverseMasses);
       ++report.impacts;
     }
-    holdContacts();
+    holdContacts(m_contacts);
     clampToColliders(start, h);
   }
 

@@ -2,9 +2,19 @@
 
 #include <weft/threading/Profiler.h>
 
+#include <algorithm>
 #include <unordered_map>
 
 namespace weft {
+namespace {
+
+// findTrianglePairsTouching: above one marked triangle in this many, the full self query
+// (filtered) is used instead of one box query per marked triangle. A box query visits a few
+// dozen nodes, a self query all overlapping node pairs of the tree. An estimate of the
+// break-even, not measured (results are the same either way; only the cost changes).
+constexpr Index kBoxQueriesPerSelfQuery = 8;
+
+}  // namespace
 
 void buildEdgeTables(const ClothModel& model, std::vector<std::array<Index, 2>>& edges,
                      std::vector<std::array<Index, 3>>& triangleEdges) {
@@ -37,6 +47,8 @@ SelfCollision::SelfCollision(const ClothModel& model, TaskSystem* tasks) : Conta
   buildEdgeTables(model, edges, triangleEdges);
   setTopology(std::move(triangles), std::move(triangleEdges), std::move(edges),
               model.restPositions(), std::vector<Index>(model.vertexCount(), 0));
+  // The proximity broad phase below reads nothing but its arguments.
+  setBroadPhaseIsPure(true);
 }
 
 void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate,
@@ -58,6 +70,42 @@ void SelfCollision::findTrianglePairs(const Vec3Array& from, const Vec3Array& to
   } else {
     bvh.querySelf(pairs);
   }
+}
+
+void SelfCollision::findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to,
+                                              Real inflate, const std::vector<char>& marked,
+                                              std::vector<TrianglePair>& pairs) {
+  Index markedCount = 0;
+  for (char flag : marked) markedCount += flag != 0;
+  // Many marked triangles: one self query is cheaper than a box query for each.
+  if (markedCount * kBoxQueriesPerSelfQuery > Index(marked.size())) {
+    ContactResolver::findTrianglePairsTouching(from, to, inflate, marked, pairs);
+    return;
+  }
+  WEFT_PROFILE_ZONE("broad phase (marked)");
+  m_sweptBvh.refit(from, to, inflate, m_tasks);
+  m_refitCounts.refitNodes += m_sweptBvh.lastRefitCounts().refitNodes;
+  m_refitCounts.skippedNodes += m_sweptBvh.lastRefitCounts().skippedNodes;
+  // Each marked triangle's own box against the tree: the pairs the self query would report with
+  // it (the same box-overlap test at the leaves), found from the marked side. A pair of two
+  // marked triangles is taken from its lower one.
+  pairs.clear();
+  const std::vector<Index>& order = m_sweptBvh.triangleOrder();
+  for (Index slot = 0; slot < order.size(); ++slot) {
+    const Index triangle = order[slot];
+    if (!marked[triangle]) continue;
+    m_sweptBvh.queryBox(m_sweptBvh.slotBounds(slot), m_boxHits);
+    const std::array<Index, 3>& a = m_sweptBvh.triangle(triangle);
+    for (Index other : m_boxHits) {
+      if (other == triangle || (marked[other] && other < triangle)) continue;
+      const std::array<Index, 3>& b = m_sweptBvh.triangle(other);
+      bool shared = false;
+      for (Index i : a) shared = shared || i == b[0] || i == b[1] || i == b[2];
+      if (shared) continue;
+      pairs.push_back({std::min(triangle, other), std::max(triangle, other)});
+    }
+  }
+  std::sort(pairs.begin(), pairs.end());
 }
 
 void SelfCollision::setRefitSkipping(Real motion) {

@@ -51,6 +51,9 @@ class SelfCollision final : public ContactResolver {
  private:
   void findTrianglePairs(const Vec3Array& from, const Vec3Array& to, Real inflate, bool proximity,
                          std::vector<TrianglePair>& pairs) override;
+  void findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to, Real inflate,
+                                 const std::vector<char>& marked,
+                                 std::vector<TrianglePair>& pairs) override;
 
   // Two trees over the same triangles: one refit for the proximity pass (static boxes inflated by
   // the thickness), one for the swept passes (inflated by ~2 µm). With one tree the two
@@ -61,6 +64,7 @@ class SelfCollision final : public ContactResolver {
   Bvh m_sweptBvh;  // continuous (swept) tests
   Bvh::RefitCounts m_refitCounts;  // summed over refits since takeRefitCounts()
   std::unique_ptr<PerWorker<std::vector<TrianglePair>>> m_workerPairs;  // with m_tasks
+  std::vector<Index> m_boxHits;  // findTrianglePairsTouching: triangles one box query found
 };
 
 }  // namespace weft
