@@ -289,6 +289,9 @@ std::vector<SweepConfig> sweepConfigs(const ErrorTimeOptions& options) {
           // their 200; a capped solve is still reported as solver-not-converged).
           config.solver.cgMaxIterations = 1000;
           config.solver.cgTolerance = tolerance;
+          // The implicit series are the residual test, named so; the default is the velocity
+          // error, which the -verr series sweeps.
+          config.solver.cgStopping = PcgStopping::RelativeResidual;
           config.solver.warmStart = warm;
           configs.push_back(config);
           // The same step with the velocity-error stopping test (SolverSettings::cgStopping); in
@@ -485,6 +488,7 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
   referenceConfig.solver.substeps = options.referenceSubsteps;
   referenceConfig.solver.newtonIterations = options.referenceNewtonIterations;
   referenceConfig.solver.cgTolerance = options.referenceCgTolerance;
+  referenceConfig.solver.cgStopping = PcgStopping::RelativeResidual;  // the "residual ≤ 1e-10"
   referenceConfig.solver.cgMaxIterations = 5000;
   std::ostringstream keyText;
   keyText << std::setprecision(17) << "weft-error-time reference v1; curtain size " << size
