@@ -9,11 +9,11 @@
 //   - one pin, or pins that coincide: translation only;
 //   - collinear pins (a cape pinned along its top edge): the rotation about their line is
 //     undetermined. The fit maps the old line onto the new one and chooses the turn about the line
-//     that keeps the plane through the line and `up` (gravity's axis) through the line and `up`:
-//     a line turned about the vertical is turned exactly so, and a line turned end for end (a
-//     half-turn, where the smallest rotation has no preferred axis) is turned about the vertical,
-//     not flipped upside down. When `up` is zero or along either line, the smallest rotation that
-//     maps the old direction onto the new one.
+//     that maps the plane of the old line and `up` (gravity) onto the plane of the new line and
+//     `up`, the side `up` points to kept: a line turned about the vertical is turned exactly so,
+//     and a line turned end for end (a half-turn, where the smallest rotation has no preferred
+//     axis and round-off would pick one) turns about the vertical, not upside down. When `up` is
+//     zero or along either line, the smallest rotation that maps the old line onto the new one.
 // Serial and free of thread-dependent sums: the same bits on any thread count.
 #pragma once
 

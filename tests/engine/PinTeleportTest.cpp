@@ -1,7 +1,7 @@
 // Pins that jump far in one frame (stress scene 10, issue 9), and the energy a sleeping cloth
 // reports:
 //   - when every pin jumps farther than SolverSettings::pinTeleportDistance cloth sizes, the
-//     frame is a teleport: the cloth is carried by the pins' mean jump, velocities unchanged, and
+//     frame is a teleport: the cloth is carried by the pins' jump, velocities unchanged, and
 //     continues as if nothing had happened; one pin yanked alone is no teleport;
 //   - the carry is the pins' best-fit rigid motion: pins that jump and turn (a respawn facing the
 //     other way) carry the cloth turned, and it goes on like a sheet that stayed, seen in the
@@ -22,6 +22,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <span>
 #include <vector>
 
@@ -297,7 +298,7 @@ TEST(PinTeleport, PinsThatJumpAndTurnCarryTheClothTurned) {
   // (a full fit), gravity unchanged by the turn.
   const ClothSettings rows = twoRowCotton();
   expectCarriedAsIfNothingHappened(
-      jumpAndTurn(rows, turn(M_PI, Vec3::UnitY()), Vec3(10.0, 0.0, -4.0), false),
+      jumpAndTurn(rows, turn(std::numbers::pi, Vec3::UnitY()), Vec3(10.0, 0.0, -4.0), false),
       "top two rows, 10 m and a half-turn about the vertical");
   // An arbitrary axis and angle: gravity turns with the pins, so both sheets feel the same.
   expectCarriedAsIfNothingHappened(
@@ -312,14 +313,14 @@ TEST(PinTeleport, CollinearPinsCarryTheTurnTheyDetermine) {
   // A cape on a character respawned facing the other way: the line turns end for end, where the
   // smallest rotation has no axis; gravity's axis decides, so the sheet still hangs.
   expectCarriedAsIfNothingHappened(
-      jumpAndTurn(strip, turn(M_PI, Vec3::UnitY()), Vec3(10.0, 0.0, 0.0), false),
+      jumpAndTurn(strip, turn(std::numbers::pi, Vec3::UnitY()), Vec3(10.0, 0.0, 0.0), false),
       "top row, 10 m and a half-turn about the vertical");
   expectCarriedAsIfNothingHappened(
-      jumpAndTurn(strip, turn(M_PI / 2, Vec3::UnitY()), Vec3(0.0, 0.0, 10.0), false),
+      jumpAndTurn(strip, turn(std::numbers::pi / 2, Vec3::UnitY()), Vec3(0.0, 0.0, 10.0), false),
       "top row, 10 m and a quarter-turn about the vertical");
   // Turned about a horizontal axis across the line, gravity turning with it.
   expectCarriedAsIfNothingHappened(
-      jumpAndTurn(strip, turn(M_PI / 3, Vec3::UnitZ()), Vec3(5.0, -8.0, 2.0), true),
+      jumpAndTurn(strip, turn(std::numbers::pi / 3, Vec3::UnitZ()), Vec3(5.0, -8.0, 2.0), true),
       "top row, 10 m and 60 degrees about an axis across it");
 }
 
@@ -341,7 +342,7 @@ TEST(PinTeleport, APureHalfTurnAboutThePinsIsDraggedNotCarried) {
   const ClothId cloth = world.createCloth(model, hangingCotton()).value();
   std::vector<Vec3> targets = world.pinTargets(cloth).value();
   const Vec3 middle = targets[kColumns / 2];
-  for (Vec3& target : targets) target = turn(M_PI, Vec3::UnitY()) * (target - middle) + middle;
+  for (Vec3& target : targets) target = turn(std::numbers::pi, Vec3::UnitY()) * (target - middle) + middle;
   ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
   EXPECT_EQ(world.plannedSubsteps(cloth, kFrameDt).value(),
             Index(std::ceil(kWidth / meanEdgeLength(*model) * (1 - 1e-9))));

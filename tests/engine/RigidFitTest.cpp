@@ -5,6 +5,7 @@
 
 #include <Eigen/Geometry>
 
+#include <numbers>
 #include <vector>
 
 namespace weft {
@@ -24,7 +25,7 @@ const Vec3 kGravity(0, -9.81, 0);
 
 TEST(RigidFit, RecoversATurnAndAJumpOfPointsInAPlane) {
   const std::vector<Vec3> from = {{0, 0, 0}, {0.4, 0, 0}, {0, 0.3, 0}, {0.4, 0.3, 0}, {0.1, 0.2, 0}};
-  for (const Mat3& rotation : {turn(M_PI, Vec3::UnitY()), turn(2.1, Vec3(0.3, -0.5, 0.8)),
+  for (const Mat3& rotation : {turn(std::numbers::pi, Vec3::UnitY()), turn(2.1, Vec3(0.3, -0.5, 0.8)),
                                turn(1e-3, Vec3::UnitX())}) {
     const Vec3 shift(10, -2, 3);
     const std::vector<Vec3> to = moved(from, rotation, shift);
@@ -75,8 +76,8 @@ TEST(RigidFit, CollinearPointsTurnTheirLineKeepingGravitysPlane) {
   for (int k = 0; k < 9; ++k) row.push_back(Vec3(-0.2 + 0.05 * k, 1.0, 0.0));
   // Turned about the vertical (a half-turn too, where the smallest rotation has no axis) or about
   // a horizontal axis across the line: recovered exactly.
-  for (const Mat3& rotation : {turn(M_PI, Vec3::UnitY()), turn(M_PI / 2, Vec3::UnitY()),
-                               turn(0.7, Vec3::UnitY()), turn(M_PI / 3, Vec3::UnitZ())}) {
+  for (const Mat3& rotation : {turn(std::numbers::pi, Vec3::UnitY()), turn(std::numbers::pi / 2, Vec3::UnitY()),
+                               turn(0.7, Vec3::UnitY()), turn(std::numbers::pi / 3, Vec3::UnitZ())}) {
     const RigidFit fit = fitRigidMotion(row, moved(row, rotation, Vec3(3, 4, 5)), kGravity);
     EXPECT_EQ(fit.kind, RigidFitKind::Line);
     EXPECT_LT((fit.rotation - rotation).norm(), 1e-14);
@@ -91,7 +92,7 @@ TEST(RigidFit, CollinearPointsTurnTheirLineKeepingGravitysPlane) {
   // A line along gravity's axis turned to lie across it: the smallest rotation.
   std::vector<Vec3> column;
   for (int k = 0; k < 5; ++k) column.push_back(Vec3(0, 0.1 * k, 0));
-  const Mat3 tip = turn(M_PI / 2, Vec3::UnitZ());
+  const Mat3 tip = turn(std::numbers::pi / 2, Vec3::UnitZ());
   const RigidFit tipped = fitRigidMotion(column, moved(column, tip, Vec3::Zero()), kGravity);
   EXPECT_EQ(tipped.kind, RigidFitKind::Line);
   EXPECT_LT((tipped.rotation - tip).norm(), 1e-14);
