@@ -336,7 +336,10 @@ TEST(PinTeleport, OnePinCarriesItsJumpOnly) {
 
 TEST(PinTeleport, APureHalfTurnAboutThePinsIsDraggedNotCarried) {
   // The pins of a row turned a half-turn about their middle: the middle pin stays, so not every
-  // pin jumps and the frame is no teleport; the substep rule drags the cloth round.
+  // pin jumps and the frame is no teleport; the substep rule drags the cloth round. A known
+  // weakness, printed, not asserted: pins move on straight lines within a frame, so a row turned
+  // end for end passes through its middle pin at mid-frame; measured on this sheet, 8 substeps,
+  // strain 5.0 and 97 m/s at the frame's end (2 s later strain still 5.0, 0.14 m/s).
   const auto model = sheet();
   World world;
   const ClothId cloth = world.createCloth(model, hangingCotton()).value();
@@ -346,8 +349,12 @@ TEST(PinTeleport, APureHalfTurnAboutThePinsIsDraggedNotCarried) {
   ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
   EXPECT_EQ(world.plannedSubsteps(cloth, kFrameDt).value(),
             Index(std::ceil(kWidth / meanEdgeLength(*model) * (1 - 1e-9))));
-  world.step(kFrameDt);
+  const StepStatus status = world.step(kFrameDt);
   EXPECT_EQ(world.stats().teleportedCloths, 0u);
+  std::printf("[pin teleport] half-turn about the middle pin, dragged: %d substeps, max strain %.4f, "
+              "max speed %.3g m/s, %s\n",
+              int(world.stats().substeps), world.stats().maxStrain, world.stats().maxSpeed,
+              describe(status).c_str());
 }
 
 TEST(PinTeleport, OnePinYankedAloneOrAShortJumpIsDraggedNotCarried) {

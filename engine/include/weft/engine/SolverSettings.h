@@ -76,7 +76,9 @@ struct SolverSettings {
   /// turn about the line chosen to keep the plane of the line and gravity (so a line turned end
   /// for end turns about the vertical). A pure turn about the pins' centroid is never a teleport
   /// (the pins near the axis move less than the cloth's size): it is dragged under the substep
-  /// rule, however large. Off, the pins drag the
+  /// rule, however large, with each pin on a straight line through the frame; a row of pins
+  /// turned end for end in one frame crushes through its middle (a 0.4 m sheet: strain 5.0 at the
+  /// frame's end, tests/engine/PinTeleportTest.cpp). Turn such pins over several frames. Off, the pins drag the
   /// cloth at 600 m/s through that frame and stop dead at its end; the cloth crashes into them
   /// and can stay crushed in folds held by self-contact (stress scene 10 with it off: 6 of 24
   /// round-off-level perturbations do not settle within 2 s, bench weft-teleport-perturb).
