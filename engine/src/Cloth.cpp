@@ -373,10 +373,11 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
     // maxPinTravelPerSubstep edges (SolverSettings says why). Only a fast pin asks for more; the
     // cap still holds. In a teleport frame the cloth is carried and the pins travel relative
     // to it.
-    const Vec3 carried = teleportDisplacement();
+    const std::optional<RigidFit> carry = teleportMotion();
     Real travel = 0;
     for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
-      travel = std::max(travel, (m_pinEnd[k] - m_pinStart[k] - carried).norm());
+      const Vec3 start = carry ? carry->apply(m_pinStart[k]) : m_pinStart[k];
+      travel = std::max(travel, (m_pinEnd[k] - start).norm());
     }
     const Real reach = solver.maxPinTravelPerSubstep * m_meanEdgeLength;
     const Real pinWanted = reach > 0 ? std::ceil(travel / reach * (1 - 1e-9)) : 0;
@@ -389,18 +390,19 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
   return substeps;
 }
 
-Vec3 Cloth::teleportDisplacement() const {
+std::optional<RigidFit> Cloth::teleportMotion() const {
   const Real threshold = m_settings.solver.pinTeleportDistance * m_model->characteristicLength();
-  if (threshold <= 0 || m_pinEnd.empty()) return Vec3::Zero();
+  if (threshold <= 0 || m_pinEnd.empty()) return std::nullopt;
   // Every pin must jump: one pin yanked far while the others stay is motion to simulate (the
-  // substep rule follows it), not the whole cloth changing place.
-  Vec3 mean = Vec3::Zero();
+  // substep rule follows it), not the whole cloth changing place. So a pure turn about the pins'
+  // centroid is never a teleport, however large: the pins nearest the axis move less than the
+  // cloth's size (a row of pins turned a half-turn about its middle: the middle pin stays), and
+  // the substep rule drags the cloth round. A turn that comes with a jump farther than the
+  // cloth's size (a respawn facing the other way) is one, and the fit carries the turn too.
   for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
-    const Vec3 jump = m_pinEnd[k] - m_pinStart[k];
-    if (!(jump.norm() > threshold)) return Vec3::Zero();
-    mean += jump;
+    if (!((m_pinEnd[k] - m_pinStart[k]).norm() > threshold)) return std::nullopt;
   }
-  return mean / Real(m_pinEnd.size());
+  return fitRigidMotion(m_pinStart, m_pinEnd, m_forces.settings().gravity);
 }
 
 Real Cloth::computeForces(const Vec3Array& x, const Vec3Array& v, Real, Vec3Array& f) {
@@ -856,13 +858,20 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
   }
   m_wakeRequested = false;
 
-  // A teleport (SolverSettings::pinTeleportDistance): the cloth is carried with its pins' mean
-  // jump before the frame, velocities unchanged, so it arrives instead of being flung; the pins
-  // then move only relative to it. Before the rollback copy, so a failed frame stays carried.
-  const Vec3 carried = teleportDisplacement();
-  if (!carried.isZero()) {
-    for (Vec3& x : m_positions) x += carried;
-    for (Vec3& start : m_pinStart) start += carried;
+  // A teleport (SolverSettings::pinTeleportDistance): the cloth is carried with its pins' best-fit
+  // rigid motion before the frame, so it arrives instead of being flung; the pins then move only
+  // relative to it. The motion is rigid, so velocities turn with it (unchanged by a translation)
+  // and so does the implicit solve's warm start (a Δv per vertex, in world axes); nothing else
+  // the cloth keeps per vertex outlives a frame (the step-start copies and the collision caches
+  // are taken from the carried positions). Before the rollback copy, so a failed frame stays
+  // carried.
+  if (const std::optional<RigidFit> carry = teleportMotion()) {
+    for (Vec3& x : m_positions) x = carry->apply(x);
+    for (Vec3& start : m_pinStart) start = carry->apply(start);
+    if (!carry->translationOnly()) {
+      for (Vec3& v : m_velocities) v = carry->rotation * v;
+      m_integrator->rotateCarriedState(carry->rotation);
+    }
     report.teleported = true;
   }
 

@@ -8,6 +8,7 @@
 #include "ClothForces.h"
 #include "ColliderResponse.h"
 #include "FoldCulling.h"
+#include "RigidFit.h"
 #include "SelfCollision.h"
 #include "StrainLimiting.h"
 #include "integrators/Integrator.h"
@@ -20,6 +21,7 @@
 #include <weft/engine/World.h>
 
 #include <memory>
+#include <optional>
 
 namespace weft {
 
@@ -95,10 +97,12 @@ class Cloth final : public DynamicSystem {
   /// pin moves farther than an edge per substep towards the targets set for the frame.
   Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
 
-  /// The pins' mean displacement from the frame-start to the set targets when every pin moves
-  /// farther than SolverSettings::pinTeleportDistance cloth sizes (the frame is a teleport),
-  /// else zero.
-  Vec3 teleportDisplacement() const;
+  /// The rigid motion that carries the cloth in a teleport frame: when every pin moves farther
+  /// than SolverSettings::pinTeleportDistance cloth sizes from the frame-start to the set
+  /// targets, the best fit of the pins' old targets onto the new ones (RigidFit: rotation and
+  /// translation; translation only for one pin; for collinear pins the turn about their line is
+  /// chosen with gravity's axis); else nullopt (no teleport).
+  std::optional<RigidFit> teleportMotion() const;
 
   Status setPinTargets(std::span<const Vec3> targets);
   /// N per vertex, added to every evaluation until changed; an empty span removes them.

@@ -1,8 +1,11 @@
 // Pins that jump far in one frame (stress scene 10, issue 9), and the energy a sleeping cloth
 // reports:
 //   - when every pin jumps farther than SolverSettings::pinTeleportDistance cloth sizes, the
-//     frame is a teleport: the cloth is carried by the pins' mean jump, velocities unchanged, and
+//     frame is a teleport: the cloth is carried by the pins' jump, velocities unchanged, and
 //     continues as if nothing had happened; one pin yanked alone is no teleport;
+//   - the carry is the pins' best-fit rigid motion: pins that jump and turn (a respawn facing the
+//     other way) carry the cloth turned, and it goes on like a sheet that stayed, seen in the
+//     turned frame; collinear pins and a single pin carry what they determine;
 //   - otherwise (or with the teleport off), automatic substepping keeps every pin within one mean
 //     edge length per substep, so a cloth whose pins jump 10 m is hauled after them within its
 //     strain limit in that frame (in one substep the limiter stopped at its iteration cap with
@@ -12,11 +15,14 @@
 #include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
 
+#include <Eigen/Geometry>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <numbers>
 #include <span>
 #include <vector>
 
@@ -217,6 +223,138 @@ TEST(PinTeleport, PinsThatAllJumpCarryTheClothWhichGoesOnAsIfNothingHappened) {
   const auto x = twins.jumped.positions(twins.jumpedCloth).value();
   const std::vector<Index>& pins = settings.pinnedVertices;
   for (std::size_t k = 0; k < pins.size(); ++k) EXPECT_EQ(x[pins[k]], targets[k]) << k;
+}
+
+// Cotton hanging from its top two rows: pins that are not collinear, so they determine a full
+// rotation. (Pinned at its four corners instead, the sheet's own weight compresses the columns
+// above the lower corners: it buckles out of its plane from round-off, and a turned copy, whose
+// round-off differs, buckles its own way, 1 to 4 cm apart within 1 s.)
+ClothSettings twoRowCotton() {
+  ClothSettings settings;
+  settings.material = cottonFabric();
+  for (Index c = 0; c < 2 * kColumns; ++c) settings.pinnedVertices.push_back((kRows - 2) * kColumns + c);
+  settings.sleep.enabled = false;
+  return settings;
+}
+
+struct CarryGaps {
+  Real position = 0, velocity = 0, speedAtJump = 0, stayedSpeedAtJump = 0;
+  Index substepsOverOne = 0, teleportFrames = 0, notOk = 0;
+};
+
+// Twin worlds; the jumped one's pins move by x ↦ rotation · x + shift in one frame (its gravity
+// turns with them when `turnGravity`, so the turned sheet feels what the other one feels), then
+// both run 1 s. Gaps: the jumped sheet against the stayed one carried by the same motion.
+CarryGaps jumpAndTurn(const ClothSettings& settings, const Mat3& rotation, const Vec3& shift,
+                      bool turnGravity) {
+  TwinWorlds twins(settings);
+  std::vector<Vec3> targets = twins.jumped.pinTargets(twins.jumpedCloth).value();
+  for (Vec3& target : targets) target = rotation * target + shift;
+  EXPECT_TRUE(twins.jumped.setPinTargets(twins.jumpedCloth, targets).ok());
+  if (turnGravity) {
+    EXPECT_TRUE(twins.jumped.setGravity(rotation * Vec3(0, -9.81, 0)).ok());
+  }
+  EXPECT_GT(twins.jumped.stats().kineticEnergy, 0.0);  // the sheet still moves when it jumps
+  CarryGaps gaps;
+  for (int frame = 0; frame < 60; ++frame) {
+    gaps.notOk += twins.jumped.step(kFrameDt) != StepStatus::Ok;
+    twins.stayed.step(kFrameDt);
+    gaps.teleportFrames += twins.jumped.stats().teleportedCloths;
+    gaps.substepsOverOne += twins.jumped.stats().substeps != 1;
+    if (frame == 0) {
+      gaps.speedAtJump = twins.jumped.stats().maxSpeed;
+      gaps.stayedSpeedAtJump = twins.stayed.stats().maxSpeed;
+    }
+    const auto x = twins.jumped.positions(twins.jumpedCloth).value();
+    const auto v = twins.jumped.velocities(twins.jumpedCloth).value();
+    const auto y = twins.stayed.positions(twins.stayedCloth).value();
+    const auto w = twins.stayed.velocities(twins.stayedCloth).value();
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      gaps.position = std::max(gaps.position, (x[i] - (rotation * y[i] + shift)).norm());
+      gaps.velocity = std::max(gaps.velocity, (v[i] - rotation * w[i]).norm());
+    }
+  }
+  return gaps;
+}
+
+void expectCarriedAsIfNothingHappened(const CarryGaps& gaps, const char* what) {
+  std::printf("[pin teleport] %s: against the sheet that stayed over 1 s %.3g m, %.3g m/s\n",
+              what, gaps.position, gaps.velocity);
+  EXPECT_EQ(gaps.teleportFrames, 1) << what;
+  EXPECT_EQ(gaps.notOk, 0) << what;
+  EXPECT_EQ(gaps.substepsOverOne, 0) << what;  // no pin moves relative to the carried cloth
+  // Not dragged through the turn: as fast as the sheet that stayed, not hundreds of m/s.
+  EXPECT_LT(gaps.speedAtJump, gaps.stayedSpeedAtJump + 1e-6) << what;
+  EXPECT_LT(gaps.position, 1e-9) << what;
+  EXPECT_LT(gaps.velocity, 1e-7) << what;
+}
+
+Mat3 turn(Real angle, const Vec3& axis) {
+  return Eigen::AngleAxis<Real>(angle, axis.normalized()).toRotationMatrix();
+}
+
+TEST(PinTeleport, PinsThatJumpAndTurnCarryTheClothTurned) {
+  // A respawn facing the other way: 10 m and a half-turn about the vertical. Pins on the top two rows
+  // (a full fit), gravity unchanged by the turn.
+  const ClothSettings rows = twoRowCotton();
+  expectCarriedAsIfNothingHappened(
+      jumpAndTurn(rows, turn(std::numbers::pi, Vec3::UnitY()), Vec3(10.0, 0.0, -4.0), false),
+      "top two rows, 10 m and a half-turn about the vertical");
+  // An arbitrary axis and angle: gravity turns with the pins, so both sheets feel the same.
+  expectCarriedAsIfNothingHappened(
+      jumpAndTurn(rows, turn(2.1, Vec3(0.3, -0.5, 0.8)), Vec3(-3.0, 7.0, 5.0), true),
+      "top two rows, 2.1 rad about (0.3, -0.5, 0.8)");
+}
+
+TEST(PinTeleport, CollinearPinsCarryTheTurnTheyDetermine) {
+  // A strip hanging from its top row (collinear pins; the turn about their line is undetermined).
+  ClothSettings strip = hangingCotton();
+  strip.sleep.enabled = false;
+  // A cape on a character respawned facing the other way: the line turns end for end, where the
+  // smallest rotation has no axis; gravity's axis decides, so the sheet still hangs.
+  expectCarriedAsIfNothingHappened(
+      jumpAndTurn(strip, turn(std::numbers::pi, Vec3::UnitY()), Vec3(10.0, 0.0, 0.0), false),
+      "top row, 10 m and a half-turn about the vertical");
+  expectCarriedAsIfNothingHappened(
+      jumpAndTurn(strip, turn(std::numbers::pi / 2, Vec3::UnitY()), Vec3(0.0, 0.0, 10.0), false),
+      "top row, 10 m and a quarter-turn about the vertical");
+  // Turned about a horizontal axis across the line, gravity turning with it.
+  expectCarriedAsIfNothingHappened(
+      jumpAndTurn(strip, turn(std::numbers::pi / 3, Vec3::UnitZ()), Vec3(5.0, -8.0, 2.0), true),
+      "top row, 10 m and 60 degrees about an axis across it");
+}
+
+TEST(PinTeleport, OnePinCarriesItsJumpOnly) {
+  // One pin determines no rotation: carried by its jump, the sheet goes on as the one that stayed.
+  ClothSettings corner;
+  corner.material = cottonFabric();
+  corner.pinnedVertices = {kRows * kColumns - 1};
+  corner.sleep.enabled = false;
+  expectCarriedAsIfNothingHappened(jumpAndTurn(corner, Mat3::Identity(), Vec3(10.0, 2.0, -3.0), false),
+                                   "one pin, 10 m");
+}
+
+TEST(PinTeleport, APureHalfTurnAboutThePinsIsDraggedNotCarried) {
+  // The pins of a row turned a half-turn about their middle: the middle pin stays, so not every
+  // pin jumps and the frame is no teleport; the substep rule drags the cloth round. A known
+  // weakness, printed, not asserted: pins move on straight lines within a frame, so a row turned
+  // end for end passes through its middle pin at mid-frame; measured on this sheet, 8 substeps,
+  // strain 5.0 and 97 m/s at the frame's end (2 s later strain still 5.0, 0.14 m/s).
+  const auto model = sheet();
+  World world;
+  const ClothId cloth = world.createCloth(model, hangingCotton()).value();
+  std::vector<Vec3> targets = world.pinTargets(cloth).value();
+  const Vec3 middle = targets[kColumns / 2];
+  for (Vec3& target : targets) target = turn(std::numbers::pi, Vec3::UnitY()) * (target - middle) + middle;
+  ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
+  EXPECT_EQ(world.plannedSubsteps(cloth, kFrameDt).value(),
+            Index(std::ceil(kWidth / meanEdgeLength(*model) * (1 - 1e-9))));
+  const StepStatus status = world.step(kFrameDt);
+  EXPECT_EQ(world.stats().teleportedCloths, 0u);
+  std::printf("[pin teleport] half-turn about the middle pin, dragged: %d substeps, max strain %.4f, "
+              "max speed %.3g m/s, %s\n",
+              int(world.stats().substeps), world.stats().maxStrain, world.stats().maxSpeed,
+              describe(status).c_str());
 }
 
 TEST(PinTeleport, OnePinYankedAloneOrAShortJumpIsDraggedNotCarried) {

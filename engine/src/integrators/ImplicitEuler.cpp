@@ -25,6 +25,11 @@ void ImplicitEuler::restoreCarriedState(const Vec3Array& in) {
   m_hasWarmStart = true;
 }
 
+void ImplicitEuler::rotateCarriedState(const Mat3& rotation) {
+  if (!m_hasWarmStart) return;
+  for (Vec3& deltaV : m_deltaV) deltaV = rotation * deltaV;
+}
+
 void ImplicitEuler::resizeVertices(Index vertexCount) {
   if (m_deltaV.size() == vertexCount) return;
   for (Vec3Array* array : {&m_deltaV, &m_force, &m_stiffnessTimesVelocity, &m_rightHandSide,

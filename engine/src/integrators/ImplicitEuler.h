@@ -42,6 +42,7 @@ class ImplicitEuler final : public Integrator {
   }
   void saveCarriedState(Vec3Array& out) const override;
   void restoreCarriedState(const Vec3Array& in) override;
+  void rotateCarriedState(const Mat3& rotation) override;
 
  private:
   void resizeVertices(Index vertexCount);

@@ -53,6 +53,9 @@ class Integrator {
   virtual void saveCarriedState(Vec3Array& out) const { out.clear(); }
   /// Restores what saveCarriedState() wrote (an empty array = no carried state).
   virtual void restoreCarriedState(const Vec3Array& in) { (void)in; reset(); }
+  /// Turns the carried state with a rigid motion of the whole system (a pin teleport that turns
+  /// the cloth): world-axis vectors are multiplied by `rotation`.
+  virtual void rotateCarriedState(const Mat3& rotation) { (void)rotation; }
 };
 
 /// Largest step h (s) at which `kind` keeps a damped linear mode ẍ = −ω² x − c ẋ from growing by

@@ -64,12 +64,21 @@ struct SolverSettings {
   Real maxPinTravelPerSubstep = 1;
   /// Cloth sizes (ClothModel::characteristicLength, the rest shape's bounding-box diagonal) a pin
   /// may move in one frame before the frame is a teleport, when every pin of the cloth moves
-  /// farther than that; 0 = never. A teleport frame carries the whole cloth by the pins' mean
-  /// displacement at its start, velocities unchanged, and simulates only the pins' motion
-  /// relative to it (none when they all jump together), under the substep rule above; one pin
+  /// farther than that; 0 = never. A teleport frame carries the whole cloth at its start by the
+  /// pins' best-fit rigid motion (old targets onto new: the centroids' translation and the
+  /// least-squares rotation), turning velocities with it, and simulates only the pins' motion
+  /// relative to it (none when they all move rigidly), under the substep rule above; one pin
   /// yanked far while the others stay is no teleport. So setPinTargets() moving a hanging
-  /// cloth's pins 10 m puts it there hanging as before, the way game engines treat a character
-  /// that jumps farther in a frame than it could move (a respawn, a cut). Off, the pins drag the
+  /// cloth's pins 10 m, turned or not, puts it there hanging as before, the way game engines
+  /// treat a character that jumps farther in a frame than it could move (a respawn facing another
+  /// way, a cut). Pins that do not determine a rotation carry what they determine: one pin, its
+  /// jump; pins on one line (a cape pinned along its top edge), the turn of that line, with the
+  /// turn about the line chosen to keep the plane of the line and gravity (so a line turned end
+  /// for end turns about the vertical). A pure turn about the pins' centroid is never a teleport
+  /// (the pins near the axis move less than the cloth's size): it is dragged under the substep
+  /// rule, however large, with each pin on a straight line through the frame; a row of pins
+  /// turned end for end in one frame crushes through its middle (a 0.4 m sheet: strain 5.0 at the
+  /// frame's end, tests/engine/PinTeleportTest.cpp). Turn such pins over several frames. Off, the pins drag the
   /// cloth at 600 m/s through that frame and stop dead at its end; the cloth crashes into them
   /// and can stay crushed in folds held by self-contact (stress scene 10 with it off: 6 of 24
   /// round-off-level perturbations do not settle within 2 s, bench weft-teleport-perturb).
