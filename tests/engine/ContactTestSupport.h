@@ -29,6 +29,23 @@ inline std::shared_ptr<const ClothModel> horizontalSquare(Index vertices, Real s
   return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
 }
 
+/// Appends a horizontal square grid of vertices × vertices centred on `centre` (front face +y)
+/// to `mesh`, for models made of several disconnected layers (ClothModel::fromMesh); returns the
+/// index of its first vertex.
+inline Index appendHorizontalSquare(TriangleMesh& mesh, Index vertices, Real size, const Vec3& centre) {
+  GridSettings grid;
+  grid.columns = grid.rows = vertices;
+  grid.width = grid.height = size;
+  grid.origin = centre + Vec3(-size / 2, 0, size / 2);
+  grid.widthAxis = Vec3(1, 0, 0);
+  grid.heightAxis = Vec3(0, 0, -1);
+  const ClothModel layer = ClothModel::grid(grid).value();
+  const Index first = Index(mesh.positions.size());
+  mesh.positions.insert(mesh.positions.end(), layer.restPositions().begin(), layer.restPositions().end());
+  for (Index index : layer.indices()) mesh.indices.push_back(first + index);
+  return first;
+}
+
 /// Counts intersecting triangle pairs of several cloths of one world taken as one mesh: pairs
 /// within each cloth and between any two (pairs sharing a vertex of one cloth are not counted,
 /// as in SelfIntersectionCounter).

@@ -3,6 +3,7 @@
 // vertex resting on a light triangle that hangs from pins, stretched. Without the hold the
 // limiter lifts the triangle through the weight (the collisions after it then pushed the light
 // triangle back down and stretched it again: stress scene 9). Then the same in a World.
+#include "ContactTestSupport.h"
 #include "StrainLimiting.h"
 
 #include <weft/engine/FabricPresets.h>
@@ -110,22 +111,9 @@ TEST(StrainLimitingSelfContact, APairAlreadyApartIsLeftAlone) {
 // scene 9, scaled down). The pad's pairs with the sheet are held inside the limiter.
 Real heavyPadOnSheetMaxStrain() {
   TriangleMesh mesh;
-  auto appendSquare = [&](Index vertices, Real size, const Vec3& centre) {
-    GridSettings grid;
-    grid.columns = grid.rows = vertices;
-    grid.width = grid.height = size;
-    grid.origin = centre + Vec3(-size / 2, 0, size / 2);
-    grid.widthAxis = Vec3(1, 0, 0);
-    grid.heightAxis = Vec3(0, 0, -1);
-    const ClothModel layer = ClothModel::grid(grid).value();
-    const Index first = Index(mesh.positions.size());
-    mesh.positions.insert(mesh.positions.end(), layer.restPositions().begin(), layer.restPositions().end());
-    for (Index index : layer.indices()) mesh.indices.push_back(first + index);
-    return first;
-  };
   constexpr Index kSheet = 9, kPad = 3;
-  appendSquare(kSheet, 0.5, Vec3(0, 1.0, 0));
-  const Index pad = appendSquare(kPad, 0.08, Vec3(0.02, 1.05, -0.03));
+  test::appendHorizontalSquare(mesh, kSheet, 0.5, Vec3(0, 1.0, 0));
+  const Index pad = test::appendHorizontalSquare(mesh, kPad, 0.08, Vec3(0.02, 1.05, -0.03));
   auto model = std::make_shared<const ClothModel>(ClothModel::fromMesh(mesh).value());
   ClothSettings settings;
   settings.material = cottonFabric();

@@ -14,6 +14,7 @@
 // objects are small cloth pads (4 × 4 vertices, 12 cm) weighing 0.5 kg each, more than three
 // times the sheet (ClothSettings::vertexMasses): colliders are kinematic, so a weight the sheet
 // has to carry must be cloth.
+#include "engine/ContactTestSupport.h"
 #include "stress/StressSupport.h"
 
 #include <cmath>
@@ -25,28 +26,8 @@ namespace {
 
 constexpr Real kFrame = 1.0 / 60.0;
 
-// Appends a horizontal square grid (front face +y) to `mesh`; returns the first vertex's index.
-Index appendSquare(TriangleMesh& mesh, Index vertices, Real size, const Vec3& centre) {
-  GridSettings grid;
-  grid.columns = grid.rows = vertices;
-  grid.width = grid.height = size;
-  grid.origin = centre + Vec3(-size / 2, 0, size / 2);
-  grid.widthAxis = Vec3(1, 0, 0);
-  grid.heightAxis = Vec3(0, 0, -1);
-  const ClothModel layer = ClothModel::grid(grid).value();
-  const Index first = Index(mesh.positions.size());
-  mesh.positions.insert(mesh.positions.end(), layer.restPositions().begin(), layer.restPositions().end());
-  for (Index index : layer.indices()) mesh.indices.push_back(first + index);
-  return first;
-}
-
-// Smallest signed distance of any cloth vertex to a collider.
-Real closestApproach(const World& world, ClothId cloth, ColliderId collider) {
-  const Shape* shape = world.collider(collider).value();
-  Real closest = std::numeric_limits<Real>::infinity();
-  for (const Vec3& x : world.positions(cloth).value()) closest = std::min(closest, queryPoint(*shape, x).distance);
-  return closest;
-}
+using test::appendHorizontalSquare;
+using test::closestApproach;
 
 TEST(StressContact, ClothOnASpinningSphereWithFriction) {
   World world;
@@ -82,7 +63,7 @@ TEST(StressContact, ClothOnASpinningSphereWithFriction) {
 
 TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
   TriangleMesh mesh;
-  for (int layer = 0; layer < 3; ++layer) appendSquare(mesh, 11, 0.5, Vec3(0, 0.5 + 0.01 * layer, 0));
+  for (int layer = 0; layer < 3; ++layer) appendHorizontalSquare(mesh, 11, 0.5, Vec3(0, 0.5 + 0.01 * layer, 0));
   auto model = std::make_shared<const ClothModel>(ClothModel::fromMesh(mesh).value());
   World world;
   ClothSettings settings;
@@ -204,9 +185,9 @@ TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) 
 TEST(StressContact, HeavyObjectsDroppedOnASheetPinnedAtItsCorners) {
   constexpr Index kSheet = 15, kPad = 4;
   TriangleMesh mesh;
-  appendSquare(mesh, kSheet, 1.0, Vec3(0, 1.0, 0));
-  const Index firstPad = appendSquare(mesh, kPad, 0.12, Vec3(-0.2, 1.25, 0.1));
-  const Index secondPad = appendSquare(mesh, kPad, 0.12, Vec3(0.15, 1.4, -0.15));
+  appendHorizontalSquare(mesh, kSheet, 1.0, Vec3(0, 1.0, 0));
+  const Index firstPad = appendHorizontalSquare(mesh, kPad, 0.12, Vec3(-0.2, 1.25, 0.1));
+  const Index secondPad = appendHorizontalSquare(mesh, kPad, 0.12, Vec3(0.15, 1.4, -0.15));
   auto model = std::make_shared<const ClothModel>(ClothModel::fromMesh(mesh).value());
   ClothSettings settings;
   settings.material = cottonFabric();  // the stress suite runs cotton, strain limiter on
