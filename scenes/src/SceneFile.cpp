@@ -363,7 +363,8 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   if (!reader.expectObject(object, path, "solver settings")) return;
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
-                    "pinTeleportDistance", "newtonIterations", "cgTolerance", "cgMaxIterations", "warmStart"});
+                    "pinTeleportDistance", "newtonIterations", "cgTolerance", "cgStopping",
+                    "cgMaxIterations", "warmStart"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
     const std::optional<IntegratorKind> kind = integratorFromName(name);
@@ -387,7 +388,19 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
                   "cloth sizes");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
-  reader.readReal(object, path, "cgTolerance", s.cgTolerance, Range::Positive, "relative residual");
+  reader.readReal(object, path, "cgTolerance", s.cgTolerance, Range::Positive,
+                  "relative, in the sense of cgStopping");
+  std::string stopping;
+  if (reader.readString(object, path, "cgStopping", stopping) && Reader::member(object, "cgStopping")) {
+    if (stopping == "relativeResidual") {
+      s.cgStopping = PcgStopping::RelativeResidual;
+    } else if (stopping == "velocityError") {
+      s.cgStopping = PcgStopping::VelocityError;
+    } else {
+      reader.fail(child(path, "cgStopping"),
+                  "\"" + stopping + "\" is unknown; choose one of: relativeResidual, velocityError");
+    }
+  }
   reader.readInteger(object, path, "cgMaxIterations", s.cgMaxIterations, 1, 1000000);
   reader.readBool(object, path, "warmStart", s.warmStart);
 }

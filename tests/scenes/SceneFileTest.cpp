@@ -61,7 +61,8 @@ TEST(SceneFile, DefaultsAreTheDocumentedOnes) {
 TEST(SceneFile, PresetThenFieldsOverrideIt) {
   Result<SceneDescription> scene = loadSceneText(R"({"version": 1, "cloths": [{"grid": {},
       "material": {"preset": "denim", "friction": 0.7},
-      "solver": {"integrator": "rk4", "substeps": 12, "pinTeleportDistance": 0},
+      "solver": {"integrator": "rk4", "substeps": 12, "pinTeleportDistance": 0,
+                 "cgStopping": "velocityError"},
       "forceModel": "mass-spring"}]})");
   ASSERT_TRUE(scene.ok()) << scene.error().message;
   const ClothSettings& settings = scene->cloths[0].settings;
@@ -70,6 +71,7 @@ TEST(SceneFile, PresetThenFieldsOverrideIt) {
   EXPECT_EQ(settings.solver.integrator, IntegratorKind::RungeKutta4);
   EXPECT_EQ(settings.solver.substeps, 12u);
   EXPECT_EQ(settings.solver.pinTeleportDistance, 0.0);
+  EXPECT_EQ(settings.solver.cgStopping, PcgStopping::VelocityError);
   EXPECT_EQ(settings.forceModel, ForceModel::MassSpring);
 }
 
@@ -158,6 +160,8 @@ INSTANTIATE_TEST_SUITE_P(
                  "/cloths/0/material/preset", "choose one of: cotton, wool"},
         BadScene{"UnknownIntegrator", CLOTH(R"(, "solver": {"integrator": "verlet"})"),
                  "/cloths/0/solver/integrator", "implicit-euler"},
+        BadScene{"UnknownCgStopping", CLOTH(R"(, "solver": {"cgStopping": "energy"})"),
+                 "/cloths/0/solver/cgStopping", "relativeResidual, velocityError"},
         BadScene{"NegativeTeleportDistance", CLOTH(R"(, "solver": {"pinTeleportDistance": -1})"),
                  "/cloths/0/solver/pinTeleportDistance", "cloth sizes"},
         BadScene{"WrongVectorLength", CLOTH(R"(, "translation": [1, 2])"),
