@@ -2,6 +2,7 @@
 // the kernel's held vertices and Gauss–Seidel order alone, then in a World, where a collider's
 // response and friction used to stretch the cloth after the limiter.
 #include "StrainLimiting.h"
+#include "StrainLimitingTestSupport.h"
 #include "ContactTestSupport.h"
 
 #include <weft/engine/FabricPresets.h>
@@ -17,14 +18,8 @@
 namespace weft {
 namespace {
 
-constexpr Real kStep = 1.0 / 60.0;
-
-Edge makeEdge(Index a, Index b, Real restLength) {
-  Edge edge;
-  edge.vertices = {a, b};
-  edge.restLength = restLength;
-  return edge;
-}
+using test::kStep;
+using test::makeEdge;
 
 TEST(StrainLimitingInContact, AHeldVertexSlidesOnItsSurfaceAndTheEdgeComesToTheLimit) {
   TaskSystem tasks(TaskSystemSettings{1});

@@ -5,6 +5,7 @@
 // triangle back down and stretched it again: stress scene 9). Then the same in a World.
 #include "ContactTestSupport.h"
 #include "StrainLimiting.h"
+#include "StrainLimitingTestSupport.h"
 
 #include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
@@ -19,15 +20,9 @@
 namespace weft {
 namespace {
 
-constexpr Real kStep = 1.0 / 60.0;
+using test::kStep;
+using test::makeEdge;
 constexpr Real kSeparation = 0.003;  // m, the cotton preset's thickness
-
-Edge makeEdge(Index a, Index b, Real restLength) {
-  Edge edge;
-  edge.vertices = {a, b};
-  edge.restLength = restLength;
-  return edge;
-}
 
 // Pins 0, 1, 2 at y = 0; a light triangle 3, 4, 5 hanging 1.5 m below them on edges of rest
 // length 1 (strain 0.5); a heavy vertex 6 resting on the triangle's centre, kSeparation above it.

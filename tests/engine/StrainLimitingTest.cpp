@@ -1,6 +1,7 @@
 // Strain limiting (engine/src/StrainLimiting.h): the kernel alone on pairs, chains and a grid,
 // then in a World, where a heavy mass hangs on a sheet.
 #include "StrainLimiting.h"
+#include "StrainLimitingTestSupport.h"
 
 #include <weft/engine/World.h>
 
@@ -17,14 +18,8 @@
 namespace weft {
 namespace {
 
-constexpr Real kStep = 1.0 / 60.0;
-
-Edge makeEdge(Index a, Index b, Real restLength) {
-  Edge edge;
-  edge.vertices = {a, b};
-  edge.restLength = restLength;
-  return edge;
-}
+using test::kStep;
+using test::makeEdge;
 
 Vec3 momentum(const std::vector<Real>& masses, const Vec3Array& v) {
   Vec3 total = Vec3::Zero();
