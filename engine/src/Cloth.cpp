@@ -355,7 +355,8 @@ void Cloth::estimateStiffestMode() {
                                  m_stiffestDampingRate, kExplicitGrowthPerStep);
 }
 
-Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
+Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable,
+                             const std::optional<RigidFit>& carry) const {
   const SolverSettings& solver = m_settings.solver;
   if (predictedUnstable) *predictedUnstable = false;
   const bool implicit = solver.integrator == IntegratorKind::ImplicitEuler;
@@ -373,7 +374,6 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable) const {
     // maxPinTravelPerSubstep edges (SolverSettings says why). Only a fast pin asks for more; the
     // cap still holds. In a teleport frame the cloth is carried and the pins travel relative
     // to it.
-    const std::optional<RigidFit> carry = teleportMotion();
     Real travel = 0;
     for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
       const Vec3 start = carry ? carry->apply(m_pinStart[k]) : m_pinStart[k];
@@ -875,8 +875,10 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
     report.teleported = true;
   }
 
+  // The carry is applied: the pins' frame-start targets above are already carried, so their
+  // travel is measured as it is (fitting them again would look for a second teleport).
   bool predictedUnstable = false;
-  Index substeps = plannedSubsteps(frameDt, &predictedUnstable);
+  Index substeps = plannedSubsteps(frameDt, &predictedUnstable, std::nullopt);
   if (plan.substeps > 0) {
     substeps = plan.substeps;
     predictedUnstable = m_settings.solver.integrator != IntegratorKind::ImplicitEuler &&

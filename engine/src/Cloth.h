@@ -95,7 +95,13 @@ class Cloth final : public DynamicSystem {
   /// Substeps this cloth takes for a frame of frameDt; `predictedUnstable` is set when an
   /// explicit method would need more than maxSubsteps. In automatic mode also enough that no
   /// pin moves farther than an edge per substep towards the targets set for the frame.
-  Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const;
+  Index plannedSubsteps(Real frameDt, bool* predictedUnstable = nullptr) const {
+    return plannedSubsteps(frameDt, predictedUnstable, teleportMotion());
+  }
+  /// The same, with the pins' travel measured from their frame-start targets carried by `carry`
+  /// (the teleport still to come this frame; nullopt once stepFrame has carried the cloth).
+  Index plannedSubsteps(Real frameDt, bool* predictedUnstable,
+                        const std::optional<RigidFit>& carry) const;
 
   /// The rigid motion that carries the cloth in a teleport frame: when every pin moves farther
   /// than SolverSettings::pinTeleportDistance cloth sizes from the frame-start to the set
