@@ -172,6 +172,11 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
            std::to_string(solver.pinTeleportDistance) +
            " must be a finite number of cloth sizes >= 0 (0 = pins never teleport the cloth)";
   }
+  if (!(solver.pinTeleportAngle >= 0) || !std::isfinite(solver.pinTeleportAngle)) {
+    return "cloth settings: solver.pinTeleportAngle = " + std::to_string(solver.pinTeleportAngle) +
+           " must be a finite angle in radians >= 0 (0 = a turn of the pins never teleports the "
+           "cloth)";
+  }
   if (!settings.translation.allFinite() || !settings.rotation.allFinite()) {
     return "cloth settings: translation or rotation contains NaN or infinity";
   }
@@ -391,18 +396,33 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable,
 }
 
 std::optional<RigidFit> Cloth::teleportMotion() const {
-  const Real threshold = m_settings.solver.pinTeleportDistance * m_model->characteristicLength();
-  if (threshold <= 0 || m_pinEnd.empty()) return std::nullopt;
+  const SolverSettings& solver = m_settings.solver;
+  if (m_pinEnd.empty()) return std::nullopt;
+  const Vec3& up = m_forces.settings().gravity;
   // Every pin must jump: one pin yanked far while the others stay is motion to simulate (the
-  // substep rule follows it), not the whole cloth changing place. So a pure turn about the pins'
-  // centroid is never a teleport, however large: the pins nearest the axis move less than the
-  // cloth's size (a row of pins turned a half-turn about its middle: the middle pin stays), and
-  // the substep rule drags the cloth round. A turn that comes with a jump farther than the
-  // cloth's size (a respawn facing the other way) is one, and the fit carries the turn too.
+  // substep rule follows it), not the whole cloth changing place.
+  const Real threshold = solver.pinTeleportDistance * m_model->characteristicLength();
+  bool everyPinJumped = threshold > 0;
+  Real farthest = 0;
   for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
-    if (!((m_pinEnd[k] - m_pinStart[k]).norm() > threshold)) return std::nullopt;
+    const Real travel = (m_pinEnd[k] - m_pinStart[k]).norm();
+    everyPinJumped = everyPinJumped && travel > threshold;
+    farthest = std::max(farthest, travel);
   }
-  return fitRigidMotion(m_pinStart, m_pinEnd, m_forces.settings().gravity);
+  if (everyPinJumped) return fitRigidMotion(m_pinStart, m_pinEnd, up);
+  // A turn in place (SolverSettings::pinTeleportAngle): the pins near its axis hardly move, so
+  // only the fit sees it. Pins that all stay within an edge are followed by one substep whatever
+  // their turn, so the fit (a 3 × 3 SVD) runs only when some pin moved farther; a cloth whose pins
+  // stand still or creep pays nothing.
+  if (!(solver.pinTeleportAngle > 0) || !(farthest > m_meanEdgeLength)) return std::nullopt;
+  const RigidFit fit = fitRigidMotion(m_pinStart, m_pinEnd, up);
+  if (!(fit.angle() > solver.pinTeleportAngle)) return std::nullopt;
+  // Rigid: every pin where the motion puts it, to within an edge (what one substep follows).
+  // Otherwise the pins deform the cloth (a twist, one end swung round), which is to be simulated.
+  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
+    if (!((fit.apply(m_pinStart[k]) - m_pinEnd[k]).norm() <= m_meanEdgeLength)) return std::nullopt;
+  }
+  return fit;
 }
 
 Real Cloth::computeForces(const Vec3Array& x, const Vec3Array& v, Real, Vec3Array& f) {
@@ -858,7 +878,7 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
   }
   m_wakeRequested = false;
 
-  // A teleport (SolverSettings::pinTeleportDistance): the cloth is carried with its pins' best-fit
+  // A teleport (SolverSettings::pinTeleportDistance, pinTeleportAngle): the cloth is carried with its pins' best-fit
   // rigid motion before the frame, so it arrives instead of being flung; the pins then move only
   // relative to it. The motion is rigid, so velocities turn with it (unchanged by a translation)
   // and so does the implicit solve's warm start (a Δv per vertex, in world axes); nothing else

@@ -107,7 +107,8 @@ class Cloth final : public DynamicSystem {
   /// than SolverSettings::pinTeleportDistance cloth sizes from the frame-start to the set
   /// targets, the best fit of the pins' old targets onto the new ones (RigidFit: rotation and
   /// translation; translation only for one pin; for collinear pins the turn about their line is
-  /// chosen with gravity's axis); else nullopt (no teleport).
+  /// chosen with gravity's axis); the same fit when the pins turn rigidly by more than
+  /// SolverSettings::pinTeleportAngle; else nullopt (no teleport).
   std::optional<RigidFit> teleportMotion() const;
 
   Status setPinTargets(std::span<const Vec3> targets);

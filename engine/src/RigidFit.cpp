@@ -3,6 +3,7 @@
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
 
+#include <algorithm>
 #include <cmath>
 
 namespace weft {
@@ -35,6 +36,11 @@ bool frameAlong(const Vec3& direction, const Vec3& up, Mat3& frame) {
 }
 
 }  // namespace
+
+Real RigidFit::angle() const {
+  // trace R = 1 + 2 cos θ; clamped, since round-off may leave |cos θ| a hair over 1.
+  return std::acos(std::clamp((rotation.trace() - 1) / 2, Real(-1), Real(1)));
+}
 
 RigidFit fitRigidMotion(std::span<const Vec3> from, std::span<const Vec3> to, const Vec3& up) {
   RigidFit fit;

@@ -41,6 +41,8 @@ struct RigidFit {
   RigidFitKind kind = RigidFitKind::Translation;
   /// True when the rotation is exactly the identity (a translation carries x + meanDisplacement).
   bool translationOnly() const { return rotation == Mat3::Identity(); }
+  /// rad, in [0, π]: the angle the rotation turns about its axis.
+  Real angle() const;
   Vec3 apply(const Vec3& x) const {
     return translationOnly() ? Vec3(x + meanDisplacement)
                              : Vec3(rotation * (x - fromCentroid) + toCentroid);

@@ -363,7 +363,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   if (!reader.expectObject(object, path, "solver settings")) return;
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
-                    "pinTeleportDistance", "newtonIterations", "cgTolerance", "cgStopping",
+                    "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "cgTolerance", "cgStopping",
                     "cgMaxIterations", "warmStart"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
@@ -387,6 +387,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
                   "mean edge lengths");
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
                   "cloth sizes");
+  reader.readReal(object, path, "pinTeleportAngle", s.pinTeleportAngle, Range::NonNegative, "rad");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
   reader.readReal(object, path, "cgTolerance", s.cgTolerance, Range::Positive,
                   "relative, in the sense of cgStopping");

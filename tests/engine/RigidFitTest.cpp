@@ -36,6 +36,17 @@ TEST(RigidFit, RecoversATurnAndAJumpOfPointsInAPlane) {
   }
 }
 
+TEST(RigidFit, AngleIsTheTurnAboutTheAxis) {
+  // pinTeleportAngle compares against it: exact at 0 and π, where acos is at its ends.
+  for (Real angle : {Real(0), Real(1e-3), Real(0.5), std::numbers::pi / 2, Real(3.0), std::numbers::pi}) {
+    RigidFit fit;
+    fit.rotation = turn(angle, Vec3(0.3, -0.5, 0.8));
+    EXPECT_NEAR(fit.angle(), angle, 1e-7) << angle;  // acos loses half the digits near 0 and π
+  }
+  RigidFit identity;
+  EXPECT_EQ(identity.angle(), 0.0);
+}
+
 TEST(RigidFit, NeverReturnsAReflection) {
   // The targets are the points mirrored (z → −z of a non-planar set): the best proper rotation,
   // det +1, not the mirror.

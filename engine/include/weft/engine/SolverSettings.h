@@ -74,11 +74,8 @@ struct SolverSettings {
   /// way, a cut). Pins that do not determine a rotation carry what they determine: one pin, its
   /// jump; pins on one line (a cape pinned along its top edge), the turn of that line, with the
   /// turn about the line chosen to keep the plane of the line and gravity (so a line turned end
-  /// for end turns about the vertical). A pure turn about the pins' centroid is never a teleport
-  /// (the pins near the axis move less than the cloth's size): it is dragged under the substep
-  /// rule, however large, with each pin on a straight line through the frame; a row of pins
-  /// turned end for end in one frame crushes through its middle (a 0.4 m sheet: strain 5.0 at the
-  /// frame's end, tests/engine/PinTeleportTest.cpp). Turn such pins over several frames. Off, the pins drag the
+  /// for end turns about the vertical). A turn in place, where the pins near the axis move less
+  /// than this, is a teleport by pinTeleportAngle instead. Off, the pins drag the
   /// cloth at 600 m/s through that frame and stop dead at its end; the cloth crashes into them
   /// and can stay crushed in folds held by self-contact (stress scene 10 with it off: 6 of 24
   /// round-off-level perturbations do not settle within 2 s, bench weft-teleport-perturb).
@@ -86,6 +83,18 @@ struct SolverSettings {
   /// 60 Hz) are carried every frame, so the cloth no longer feels that motion (nor the air it
   /// moves through): raise it or turn it off for such a cloth.
   Real pinTeleportDistance = 1;
+  /// rad: a frame in which the pins turn as one rigid body (each pin within a mean rest edge of
+  /// where their best-fit rigid motion puts it, and some pin moving farther than an edge) by more
+  /// than this angle is a teleport too, carried by that motion as above; 0 = never. It catches the
+  /// turns in place that pinTeleportDistance cannot (pins near the turn's axis hardly move: a
+  /// character snapped round to face the other way). Dragged instead, each pin moves on a straight
+  /// line through the frame, so the pins of a row turned end for end pass through their middle
+  /// and crush the cloth there (a 0.4 m sheet: strain 5.0 at the frame's end, still 5.0 two seconds
+  /// later, tests/engine/PinTeleportTest.cpp). A quarter-turn (the default) is 15 turns per second
+  /// at 60 Hz, far beyond any animated attachment, and a dragged quarter-turn shortens a row's
+  /// chord by at most 29 %, which the cloth takes as buckling (same file: strain ≤ the limit).
+  /// Pins moved non-rigidly (one end swung round, a twist) are never carried by this rule.
+  Real pinTeleportAngle = 1.5707963267948966;
   Real maxImplicitStep = 1.0 / 60.0;  ///< s, largest implicit substep in automatic mode
   /// Cap on automatic substeps per frame; an explicit method that would need more is stepped at
   /// the cap and reported unstable (StepStatus::Unstable), never silently.

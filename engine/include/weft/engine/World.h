@@ -145,8 +145,9 @@ class World {
 
   /// Sets where the pinned vertices are at the end of the next frame (one target per entry of
   /// ClothSettings::pinnedVertices, same order). Pins move linearly across the frame; when every
-  /// pin jumps farther than SolverSettings::pinTeleportDistance, the frame is a teleport and the
-  /// cloth is carried with them instead of dragged. On error nothing changes.
+  /// pin jumps farther than SolverSettings::pinTeleportDistance, or the pins turn rigidly by more
+  /// than SolverSettings::pinTeleportAngle, the frame is a teleport and the cloth is carried with
+  /// them instead of dragged. On error nothing changes.
   Status setPinTargets(ClothId cloth, std::span<const Vec3> targets);
   /// Adds a kinematic collider (plane, sphere, capsule, box or triangle mesh; see
   /// weft/collision). Its motion (pose and velocities) is the shape's own; it moves with those
