@@ -65,7 +65,10 @@
 // scaled by (1 + its limit) / (1 + the smallest limit), which the joint limiter runs with (its
 // stopping tolerance scales by the same factor, a few percent). Members whose bounds touch no
 // other have no weight there, cloths without a limit no edges; the collider normals and fixed
-// vertices are those each cloth's last substep left (Cloth::contactHolds).
+// vertices are those each cloth's last substep left (Cloth::contactHolds). Cost: rounds run in
+// frames where an edge of the cloths in contact is over its limit; scenes/data/two-layers.json
+// (silk on cotton, 2.5 times the mass per area) went from max strain 0.304 to 0.101 and from
+// 16.1 to 21.1 ms per frame at the median (one thread, shared machine, same bits on every run).
 //
 // Determinism. Members are kept in world slot order; the index space concatenates them in that
 // order; all pairs are sorted; the resolver is deterministic (ContactResolver.h).
