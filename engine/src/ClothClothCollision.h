@@ -54,11 +54,12 @@
 // stage) of very different masses as Cloth holds them (kHeldContactMassRatio). Cloth's per-vertex
 // mass ratio does not fit two cloths: a pad's border and corner vertices carry a half and a
 // sixth of an interior one's mass, so under a pad 30 times as dense as the sheet most pairs fell
-// below the ratio and the sheet reached 0.11–0.49 (0.15–0.23 at 3 times as dense, where no pair
+// below the ratio and the sheet reached 0.11–0.49 (0.14–0.23 at 3 times as dense, where no pair
 // passes it; 8.7–12.9 and 0.14–0.23 with no limiter here); holding every pair between the
 // cloths, 0.101 from 3 to 300 times. Where nothing is over the limit the limiter moves nothing
-// (a pad as dense as the sheet: the same largest strains, 0.046–0.070, as without it). The folds Cloth's self-contacts keep
-// caught when all are held (stress scene 10) are within one cloth, where the rule is unchanged.
+// (a pad as dense as the sheet: the same largest strains, 0.046–0.070, as without it). The
+// folds Cloth's self-contacts keep caught when all are held (stress scene 10) are within one
+// cloth, where the rule is unchanged.
 // One limiter over all the members rather than each cloth's own with the other side fixed: a
 // held pair must move both sides (the sheet's limiter with the pad fixed could not lift it, nor
 // the pad's, which is not stretched). Each member keeps its own limit: its rest lengths are
@@ -115,9 +116,10 @@ class ClothClothCollision final : public ContactResolver {
   // Copies the index space's corrected vertices back into the cloths; true when any changed.
   bool writeBack();
   // Runs each cloth's collider response on its vertices corrected so far; true when it moved any.
-  bool resolveColliders(std::span<const ColliderFrame> colliders);
+  bool resolveColliders(std::span<const ColliderFrame> colliders, bool friction);
   // After a resolve(): writes it back, then the rounds of collider response and swept tests.
   void settleColliders(Real frameDt, std::span<const ColliderFrame> colliders,
+                       std::span<const ContactOwner> owners, bool friction,
                        SelfCollisionReport& report);
   // Appends the last resolve()'s pairs to hold (see the design note) to m_heldContacts (emptied
   // first when `restart`).
@@ -137,6 +139,7 @@ class ClothClothCollision final : public ContactResolver {
   std::vector<Aabb> m_bounds;     // per member: swept over the frame, inflated by the thickness
   std::vector<std::array<Index, 2>> m_overlaps;  // member pairs (c < d) with overlapping bounds
   std::vector<ContactOwner> m_owners;            // per member
+  std::vector<ContactOwner> m_frictionlessOwners;  // per member, friction 0 (strain-limit rounds)
   std::unique_ptr<PerWorker<std::vector<TrianglePair>>> m_workerPairs;
   std::vector<TrianglePair> m_memberPairs;  // one query's pairs, in member triangle ids
   Vec3Array m_start, m_x, m_v;                // index space: frame start, end, end velocity
