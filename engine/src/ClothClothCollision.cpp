@@ -16,10 +16,9 @@ namespace {
 // first pass. Each round starts only when the previous collider pass moved a vertex, which then
 // ends on the collider's thickness and so counts as held (ContactResolver.h) in the next one.
 constexpr int kColliderRounds = 3;
-// Rounds of "strain limiter with the pairs found held, then the pass again", as many as Cloth's
-// (kContactLimitPasses in Cloth.cpp); most frames stop after the first, when the limiter finds
-// nothing over the limit (two-layers.json: 2 rounds or fewer gave 0.1011 against 0.1010 for 6, at
-// the same cost).
+// Rounds of "strain limiter with the pairs found held, then the swept pass again", as many as
+// Cloth's (kContactLimitPasses in Cloth.cpp); most frames stop early, when the limiter finds
+// nothing over the limit.
 constexpr int kStrainLimitRounds = 6;
 
 }  // namespace
@@ -34,7 +33,6 @@ void ClothClothCollision::rebuild() {
   m_vertexOffset.assign(1, 0);
   m_triangleOffset.assign(1, 0);
   m_owners.clear();
-  m_frictionlessOwners.clear();
   m_inverseMasses.clear();
   std::vector<std::array<Index, 3>> triangles, triangleEdges;
   std::vector<std::array<Index, 2>> edges;
@@ -62,7 +60,6 @@ void ClothClothCollision::rebuild() {
     m_inverseMasses.insert(m_inverseMasses.end(), cloth.inverseMasses().begin(),
                            cloth.inverseMasses().end());
     m_owners.push_back({cloth.settings().material.thickness, cloth.settings().material.friction});
-    m_frictionlessOwners.push_back({cloth.settings().material.thickness, 0});
     m_vertexOffset.push_back(vertexOffset + model.vertexCount());
     m_triangleOffset.push_back(m_triangleOffset.back() + model.triangleCount());
   }
@@ -172,7 +169,7 @@ bool ClothClothCollision::writeBack() {
   return changed;
 }
 
-bool ClothClothCollision::resolveColliders(std::span<const ColliderFrame> colliders, bool friction) {
+bool ClothClothCollision::resolveColliders(std::span<const ColliderFrame> colliders) {
   bool moved = false;
   for (std::size_t c = 0; c < m_members.size(); ++c) {
     if (!m_active[c]) continue;
@@ -196,7 +193,7 @@ bool ClothClothCollision::resolveColliders(std::span<const ColliderFrame> collid
     m_before.assign(x.begin(), x.end());
     m_colliderResponse.resolve(m_colliders, cloth.frameStartPositions(),
                                cloth.frameStartVelocities(), cloth.settings().material.thickness,
-                               m_skip, x, cloth.correctableVelocities(), nullptr, friction);
+                               m_skip, x, cloth.correctableVelocities());
     for (Index i = 0; i < vertices; ++i) {
       if (m_skip[i] || x[i] == m_before[i]) continue;
       moved = true;
@@ -210,7 +207,6 @@ bool ClothClothCollision::resolveColliders(std::span<const ColliderFrame> collid
 }
 
 void ClothClothCollision::settleColliders(Real frameDt, std::span<const ColliderFrame> colliders,
-                                          std::span<const ContactOwner> owners, bool friction,
                                           SelfCollisionReport& report) {
   bool changed = writeBack();
   // Vertices the cloths pushed may now be in a collider: their collider response again, then
@@ -219,8 +215,8 @@ void ClothClothCollision::settleColliders(Real frameDt, std::span<const Collider
   options.velocityIsAverage = false;
   options.proximity = false;
   for (int round = 0; changed && !colliders.empty() && round < kColliderRounds; ++round) {
-    if (!resolveColliders(colliders, friction)) break;
-    const SelfCollisionReport again = resolve(m_start, frameDt, owners, m_inverseMasses, options, m_x, m_v);
+    if (!resolveColliders(colliders)) break;
+    const SelfCollisionReport again = resolve(m_start, frameDt, m_owners, m_inverseMasses, options, m_x, m_v);
     collectHeldContacts(/*restart=*/false);
     report.impacts += again.impacts;
     report.impactZones += again.impactZones;
@@ -281,24 +277,27 @@ void ClothClothCollision::limitStrainInContact(Real frameDt, std::span<const Col
       m_limitNormals[offset + i] = held ? cloth.contactHolds().normals[i] : Vec3::Zero();
     }
   }
+  // The rounds' passes run the swept stage only: the proximity stage's pairs (those of the frame
+  // start) are all held in the limiter, and running it again only applied their repulsion and
+  // friction once more, and the friction dragged the light sheet back after the pad every round,
+  // from where the limiter had just slid it (a dense pad on a sheet on the floor: 0.116 with it,
+  // 0.101 without; two-layers.json: 22.6 ms per frame with it, 16.5 without, the same strain).
+  // Within a pass the collider response keeps its friction, as in the first pass.
   ContactOptions options;
   options.velocityIsAverage = false;
+  options.proximity = false;
   for (int round = 0; round < kStrainLimitRounds && !m_heldContacts.empty(); ++round) {
     const StrainLimitReport limited = m_strainLimiter->applyInContact(
         m_strainLimitSettings, m_limitInverseMasses, m_limitNormals, frameDt, m_x, m_v, *m_tasks,
         m_heldContacts);
     if (limited.iterations == 0 || !writeBackLimited()) break;
-    // The contacts have the last word: the whole pass again on the chord the limiter left. Its
-    // friction was taken in the first pass (as Cloth's rounds take the colliders'): applied
-    // again, it dragged the light sheet back after the pad every round, which the limiter had
-    // just slid it from (a dense pad on a sheet on the floor: 0.116 with it, 0.106 without).
-    const SelfCollisionReport again =
-        resolve(m_start, frameDt, m_frictionlessOwners, m_inverseMasses, options, m_x, m_v);
+    // The contacts have the last word: no crossing along the chord the limiter left.
+    const SelfCollisionReport again = resolve(m_start, frameDt, m_owners, m_inverseMasses, options, m_x, m_v);
     collectHeldContacts(/*restart=*/false);
     report.impacts += again.impacts;
     report.impactZones += again.impactZones;
     report.frozenVertices += again.frozenVertices;
-    settleColliders(frameDt, colliders, m_frictionlessOwners, /*friction=*/false, report);
+    settleColliders(frameDt, colliders, report);
   }
 }
 
@@ -349,9 +348,9 @@ SelfCollisionReport ClothClothCollision::resolveFrame(Real frameDt,
   // Within the frame the broad phase depends on its arguments only (the members taking part and
   // their overlaps are fixed above), so the rounds of limitStrainInContact, which resolve the
   // same frame start again, reuse its proximity contacts and swept certificate
-  // (ContactResolver::setBroadPhaseIsPure; same bits, measured on two-layers.json: 23 ms instead
-  // of 33 ms per frame). Set again every frame: that forgets what another frame's members and
-  // overlaps gave.
+  // (ContactResolver::setBroadPhaseIsPure; same bits; two-layers.json: 16.1 ms per frame at the
+  // median instead of 21.6, one thread). Set again every frame: that forgets what another
+  // frame's members and overlaps gave.
   setBroadPhaseIsPure(true);
   setColliders(colliders);
   // The frame as one step: proximity at its start, swept tests along its chord.
@@ -359,7 +358,7 @@ SelfCollisionReport ClothClothCollision::resolveFrame(Real frameDt,
   options.velocityIsAverage = false;
   report = resolve(m_start, frameDt, m_owners, m_inverseMasses, options, m_x, m_v);
   collectHeldContacts(/*restart=*/true);
-  settleColliders(frameDt, colliders, m_owners, /*friction=*/true, report);
+  settleColliders(frameDt, colliders, report);
   // The strain limiter with the pairs found held, and the pass again.
   limitStrainInContact(frameDt, colliders, report);
   setColliders({});

@@ -46,7 +46,7 @@
 // 16.6 (ClothClothStrainTest). So the pass runs one strain limiter over the index space of the
 // cloths in contact (StrainLimiter::applyInContact) with the pairs it found held one-sided
 // (`separations`: every movable vertex of a pair counts as heavy as its heaviest, so lifting the
-// sheet lifts the pad), then the pass again (proximity and swept: the last word), a few rounds,
+// sheet lifts the pad), then the swept pass again (the last word), a few rounds,
 // as Cloth::limitStrainInContact does within one cloth. The pairs found in any pass of the frame
 // stay held for the rest of it: a swept hit held only in the next round was pushed through again
 // in the one after, and a hit in the last round stretched the sheet to 0.20 in 2 of 240 frames.
@@ -68,8 +68,9 @@
 // other have no weight there, cloths without a limit no edges; the collider normals and fixed
 // vertices are those each cloth's last substep left (Cloth::contactHolds). Cost: rounds run in
 // frames where an edge of the cloths in contact is over its limit; scenes/data/two-layers.json
-// (silk on cotton, 2.5 times the mass per area) went from max strain 0.304 to 0.101 and from
-// 16.1 to 21.1 ms per frame at the median (one thread, shared machine, same bits on every run).
+// (silk on cotton, 2.5 times the mass per area) went from max strain 0.304 to 0.101, at 16.1 ms
+// per frame at the median against 17.3 before (one thread, shared machine; the swept stage of
+// the rounds reuses the first pass's work, see resolveFrame).
 //
 // Determinism. Members are kept in world slot order; the index space concatenates them in that
 // order; all pairs are sorted; the resolver is deterministic (ContactResolver.h).
@@ -116,10 +117,9 @@ class ClothClothCollision final : public ContactResolver {
   // Copies the index space's corrected vertices back into the cloths; true when any changed.
   bool writeBack();
   // Runs each cloth's collider response on its vertices corrected so far; true when it moved any.
-  bool resolveColliders(std::span<const ColliderFrame> colliders, bool friction);
+  bool resolveColliders(std::span<const ColliderFrame> colliders);
   // After a resolve(): writes it back, then the rounds of collider response and swept tests.
   void settleColliders(Real frameDt, std::span<const ColliderFrame> colliders,
-                       std::span<const ContactOwner> owners, bool friction,
                        SelfCollisionReport& report);
   // Appends the last resolve()'s pairs to hold (see the design note) to m_heldContacts (emptied
   // first when `restart`).
@@ -139,7 +139,6 @@ class ClothClothCollision final : public ContactResolver {
   std::vector<Aabb> m_bounds;     // per member: swept over the frame, inflated by the thickness
   std::vector<std::array<Index, 2>> m_overlaps;  // member pairs (c < d) with overlapping bounds
   std::vector<ContactOwner> m_owners;            // per member
-  std::vector<ContactOwner> m_frictionlessOwners;  // per member, friction 0 (strain-limit rounds)
   std::unique_ptr<PerWorker<std::vector<TrianglePair>>> m_workerPairs;
   std::vector<TrianglePair> m_memberPairs;  // one query's pairs, in member triangle ids
   Vec3Array m_start, m_x, m_v;                // index space: frame start, end, end velocity

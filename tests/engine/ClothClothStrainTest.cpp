@@ -159,7 +159,8 @@ TEST(ClothClothStrain, APadWithoutALimitIsLiftedByTheSheet) {
 TEST(ClothClothStrain, ADensePadOnASheetOnTheFloorStaysOutOfTheFloor) {
   // The sheet lies on a floor under the pad: its vertices there are held along the floor's normal
   // in the pass's limiter (the cloth's collider contacts), so the held pairs lift the pad instead
-  // of pushing the sheet into the floor.
+  // of pushing the sheet into the floor. Without the held limiter: 0.434; with it but the
+  // proximity stage (and its friction) run again in every round: 0.116.
   PadOnSheet scene;
   makePadOnSheet(scene);
   RigidMotion floorPose;
