@@ -43,8 +43,9 @@ constexpr Real kWakeMargin = 0.01;
 // vertex a tenth of the thickness was tried, and let a crossing through (stress scene 10) and
 // left the jammed layers of scene 7 at strain 2.3 instead of 0.26.
 constexpr int kContactLimitPasses = 6;
-// A self-contact is held inside the strain limiter (one-sided, StrainLimiter::applyInContact's
-// `separations`) when one of its vertices is more than this many times heavier than another.
+// kHeldContactMassRatio (StrainLimiting.h, shared with ClothClothCollision): a self-contact is
+// held inside the strain limiter (one-sided, StrainLimiter::applyInContact's `separations`) when
+// one of its vertices is more than this many times heavier than another.
 // Between comparable masses the rounds above converge: each collision pass shares its correction
 // evenly, and the limiter pulls the rest back. Under a much heavier side the light one takes
 // almost all of every collision correction (a fraction m_light / m_heavy goes to the heavy side
@@ -56,7 +57,6 @@ constexpr int kContactLimitPasses = 6;
 // (0 to 4 of 6 for variants that held fewer pairs), against 14 of 18 without holds (the scene's
 // notes). So comparable masses are left to the rounds. An order of magnitude is past the mass
 // spread of one area-weighted fabric (a grid corner carries a sixth of an interior vertex's).
-constexpr Real kHeldContactMassRatio = 10;
 
 // A point farther than this from a box that holds a shape is farther than `thickness` from the
 // shape, with room for the round-off of the distance queries: skipping the narrow phase of such a

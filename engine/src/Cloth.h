@@ -163,6 +163,13 @@ class Cloth final : public DynamicSystem {
     return m_positions;
   }
   Vec3Array& correctableVelocities() { return m_velocities; }
+  /// The strain limiter's settings; null when the cloth has none (limit 0 or infinite).
+  const StrainLimitSettings* strainLimitSettings() const {
+    return m_strainLimiter ? &m_strainLimitSettings : nullptr;
+  }
+  /// With a strain limiter: the collider contacts its last substep left (normals and vertices
+  /// fixed on two surfaces), which a limiter run after the frame holds as the cloth's own does.
+  const ContactHolds& contactHolds() const { return m_contactHolds; }
 
  private:
   Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings,

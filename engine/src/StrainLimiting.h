@@ -90,7 +90,9 @@
 #include <weft/engine/ClothModel.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <algorithm>
 #include <array>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -106,6 +108,24 @@ struct SeparationHold {
   Vec3 normal = Vec3::Zero();  ///< unit, from the second side (triangle, second edge) to the first
   Real separation = 0;         ///< m, the smallest separation along the normal allowed
 };
+
+/// A contact is held inside the limiter (applyInContact's `separations`) when one of its movable
+/// vertices is more than this many times heavier than another: Cloth for its self-contacts,
+/// ClothClothCollision for contacts between cloths (the measurements are in Cloth.cpp).
+constexpr Real kHeldContactMassRatio = 10;
+
+/// True when `pair` joins movable vertices (non-zero weight and inverse mass) whose masses differ
+/// by more than kHeldContactMassRatio.
+inline bool spansHeldMassRatio(const SeparationHold& pair, std::span<const Real> inverseMasses) {
+  Real lightest = 0, heaviest = std::numeric_limits<Real>::infinity();
+  for (int k = 0; k < 4; ++k) {
+    const Real w = inverseMasses[pair.vertices[k]];
+    if (w == 0 || pair.weights[k] == 0) continue;
+    lightest = std::max(lightest, w);
+    heaviest = std::min(heaviest, w);
+  }
+  return lightest > kHeldContactMassRatio * heaviest;
+}
 
 /// How the strain limiter orders its corrections within one iteration.
 enum class StrainLimitOrder {

@@ -513,6 +513,13 @@ void World::collideCloths(Real frameDt, StepStats& stats) {
   // The colliders over the whole frame: from their start motions to where they are now.
   gatherColliderFrames(/*untilNow=*/true);
   const SelfCollisionReport report = m_clothContact->resolveFrame(frameDt, m_colliderFrames);
+  if (report.proximityContacts + report.impacts + report.impactZones > 0) {
+    // The pass moved vertices after the cloths measured their strain: the frame ends here.
+    stats.maxStrain = 0;
+    for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+      if (slot->cloth) stats.maxStrain = std::max(stats.maxStrain, slot->cloth->maxStrain());
+    }
+  }
   stats.clothContacts += report.proximityContacts;
   stats.clothImpacts += report.impacts;
   stats.clothImpactZones += report.impactZones;
