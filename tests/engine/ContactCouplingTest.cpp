@@ -88,13 +88,13 @@ TEST(ContactPenalty, ForceIsMinusTheEnergyGradientAndItsJacobianIsMinusKJtJ) {
     const Eigen::Matrix<Real, 12, 12> expected = -kStiffness * j * j.transpose();
     EXPECT_LE((jacobian - expected).norm(), 1e-6 * expected.norm());
 
-    // Apart (gap beyond the thickness): no energy, no force.
+    // Apart (gap 11 mm, beyond the thickness): no energy; the force extended linearly pulls.
     std::array<Vec3, 4> apart = x;
     apart[0] += 0.01 / weights[0] * normal;
     const ContactPenalty off = contactPenalty(apart, weights, normal, kThickness, kStiffness);
     EXPECT_FALSE(off.active);
     EXPECT_EQ(off.energy, 0);
-    EXPECT_EQ(off.force, 0);
+    EXPECT_NEAR(off.force, kStiffness * (kThickness - 0.011), 1e-12);
   }
 }
 

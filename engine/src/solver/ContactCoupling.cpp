@@ -9,11 +9,10 @@ ContactPenalty contactPenalty(std::span<const Vec3, 4> positions, const std::arr
   Vec3 point = Vec3::Zero();
   for (int k = 0; k < 4; ++k) point += weights[k] * positions[k];
   penalty.gap = normal.dot(point);
-  if (!(penalty.gap < thickness)) return penalty;
   const Real overlap = thickness - penalty.gap;
-  penalty.active = true;
-  penalty.energy = Real(0.5) * stiffness * overlap * overlap;
   penalty.force = stiffness * overlap;
+  penalty.active = penalty.gap < thickness;
+  if (penalty.active) penalty.energy = Real(0.5) * stiffness * overlap * overlap;
   return penalty;
 }
 

@@ -37,11 +37,17 @@ struct ContactCoupling {
   std::array<Real, 4> weights{};  ///< signed barycentric weights w
   Vec3 normal = Vec3::Zero();     ///< unit normal n
   Real coefficient = 0;           ///< kg, h² k + h c: what the term adds to A (≥ 0)
+  /// N, the term's normal force at the expansion point (spring and damping: k (d₀ − d) − c J v),
+  /// for the system that owns the term; the solve itself reads only the rows above.
+  Real force = 0;
+  /// N/s, the normal part of ∂f/∂x times the product velocity (−k J v): BW98's h ∂f/∂x v term.
+  Real stiffnessTimesVelocity = 0;
 };
 
-/// The penalty of one pair at positions x: its gap d = J x (m) and, when d < thickness, the
-/// energy ½ k (d₀ − d)² (J) and the force magnitude λ = k (d₀ − d) (N), so vertex k's force is
-/// λ w_k n. Inactive (d ≥ d₀): zero energy and force. A pure kernel, tested alone.
+/// The penalty of one pair at positions x: its gap d = J x (m), the spring's normal force
+/// λ = k (d₀ − d) (N; vertex k's force is λ w_k n), extended linearly beyond d₀ where it is
+/// negative (it would pull: the integrator's active set drops such a term), and the energy
+/// ½ k (d₀ − d)² (J) while in contact (d < d₀), zero apart. A pure kernel, tested alone.
 struct ContactPenalty {
   Real gap = 0;
   Real energy = 0;

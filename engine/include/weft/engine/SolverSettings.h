@@ -146,6 +146,18 @@ struct SolverSettings {
   /// right-hand side) instead of keeping them in it filtered (S = 0). Same equations, so the same
   /// motion up to the solve tolerance; the solve shrinks by one row per pin. false is for checks.
   bool removePinnedVertices = true;
+  /// Self-contacts inside the implicit solve, as a multiple of the cloth's stretch stiffness
+  /// (dimensionless; 0 = off). Each pair of the cloth closer than its thickness at the step start
+  /// (vertex–triangle or edge–edge, the self-collision pass's proximity pairs) becomes a penalty
+  /// ½ k (d₀ − d)² on its gap d along its normal, d₀ = material.thickness, with
+  /// k = selfContactStiffness × the stretch stiffness (N/m: the larger of material.warp/
+  /// weftStretchStiffness, or springs.structuralStiffness for mass–spring cloth), treated
+  /// implicitly and coupling all four vertices (engine/src/solver/ContactCoupling.h). Without it
+  /// the solve moves layers through each other towards the unconstrained equilibrium and the
+  /// self-collision pass after it pushes them back, which can keep a jammed pile stirring
+  /// (tests/README.md). The self-collision pass still runs after the solve and keeps the last
+  /// word. Implicit integrator with selfCollision only; ignored otherwise.
+  Real selfContactStiffness = 0;
 };
 
 }  // namespace weft
