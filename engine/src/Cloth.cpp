@@ -57,15 +57,6 @@ constexpr int kContactLimitPasses = 6;
 // notes). So comparable masses are left to the rounds. An order of magnitude is past the mass
 // spread of one area-weighted fabric (a grid corner carries a sixth of an interior vertex's).
 constexpr Real kHeldContactMassRatio = 10;
-// The implicit solve's self-contact pairs (SolverSettings::selfContactStiffness) are looked for
-// within this many thicknesses at the step start; a pair's penalty acts below one thickness
-// only, so the pairs between one and two are candidates the solve may push into contact within
-// the step (ImplicitEuler's active set turns them on then). Measured on the corner crumple (15
-// runs: 5 solver tolerances × 3 drop heights, stiffness 1, 2 active-set passes): 1.5, 2 and 3
-// thicknesses settled 8, 10 and 10 of 15 (within the draw of a chaotic scene); 2 catches pairs
-// that approach by up to a thickness in a step. The search costs one proximity query per
-// substep; the self-collision pass then queries its own (one thickness) again.
-constexpr Real kSelfContactSearch = 2;
 
 // A point farther than this from a box that holds a shape is farther than `thickness` from the
 // shape, with room for the round-off of the distance queries: skipping the narrow phase of such a
@@ -103,6 +94,15 @@ constexpr Real kDivergedStrain = 99;
 constexpr Real kEnergyJumpFactor = 100;
 // m/s: a speed scale below which no energy is suspicious (round-off on a cloth at rest).
 constexpr Real kQuietSpeed = 0.01;
+// The implicit solve's self-contact pairs (SolverSettings::selfContactStiffness) are looked for
+// within this many thicknesses at the step start; a pair's penalty acts below one thickness
+// only, so the pairs between one and two are candidates the solve may push into contact within
+// the step (ImplicitEuler's active set turns them on then). Measured on the corner crumple (15
+// runs: 5 solver tolerances × 3 drop heights, stiffness 1, 2 active-set passes): 1.5, 2 and 3
+// thicknesses settled 8, 10 and 10 of 15 (within the draw of a chaotic scene); 2 catches pairs
+// that approach by up to a thickness in a step. The search costs one proximity query per
+// substep; the self-collision pass then queries its own (one thickness) again.
+constexpr Real kSelfContactSearch = 2;
 
 std::string checkNonNegative(const char* field, Real value, const char* unit) {
   if (std::isfinite(value) && value >= 0) return {};
