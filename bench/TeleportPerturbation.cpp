@@ -63,7 +63,7 @@ struct Outcome {
 };
 
 Outcome runScene(const Perturbation& perturbation, Real jump, Real teleportDistance,
-                 std::FILE* trace) {
+                 Real selfContactStiffness, std::FILE* trace) {
   GridSettings grid;
   grid.columns = kColumns;
   grid.rows = kRows;
@@ -76,6 +76,7 @@ Outcome runScene(const Perturbation& perturbation, Real jump, Real teleportDista
   settings.solver.removePinnedVertices = perturbation.removePins;
   settings.sleep.enabled = perturbation.sleep;
   if (teleportDistance >= 0) settings.solver.pinTeleportDistance = teleportDistance;
+  if (selfContactStiffness >= 0) settings.solver.selfContactStiffness = selfContactStiffness;
   for (Index c = 0; c < kColumns; ++c) settings.pinnedVertices.push_back((kRows - 1) * kColumns + c);
   WorldSettings worldSettings;
   worldSettings.threadCount = 1;
@@ -171,6 +172,10 @@ int main(int argc, char** argv) {
   app.add_option("--pin-teleport-distance", teleportDistance,
                  "SolverSettings::pinTeleportDistance (cloth sizes; 0 = pins drag the cloth through "
                  "the jump); default: the engine's");
+  Real selfContactStiffness = -1;
+  app.add_option("--self-contact-stiffness", selfContactStiffness,
+                 "SolverSettings::selfContactStiffness (times the stretch stiffness; 0 = off); "
+                 "default: the engine's");
   CLI11_PARSE(app, argc, argv);
 
   const Real offsets[] = {0, 1e-12, 1e-11, 1e-10, 1e-9, 1e-8, 1e-7, 1e-6, 1e-5, 1e-4, 1e-3, 3e-3};
@@ -186,7 +191,7 @@ int main(int argc, char** argv) {
   int failures = 0;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     std::FILE* trace = int(k) == traceRun ? std::fopen(tracePath.c_str(), "w") : nullptr;
-    const Outcome outcome = runScene(runs[k], jump, teleportDistance, trace);
+    const Outcome outcome = runScene(runs[k], jump, teleportDistance, selfContactStiffness, trace);
     if (trace) std::fclose(trace);
     const bool passed = outcome.passed(jump);
     failures += !passed;

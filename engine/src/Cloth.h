@@ -80,6 +80,7 @@ class Cloth final : public DynamicSystem {
   TaskSystem* taskSystem() override { return m_tasks; }
   void constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                          VertexFilter& filter) override;
+  std::span<const ContactCoupling> contactCouplings() const override { return m_contactCouplings; }
 
   /// Advances by one frame of length frameDt starting at world time t, against colliders whose
   /// motions are given at the frame start (their shapes are posed per substep and left posed at
@@ -182,6 +183,11 @@ class Cloth final : public DynamicSystem {
   // a vertex too fast (checked every substep), None otherwise.
   HealthFailure runSubsteps(Real t, Real frameDt, Index substeps, std::span<ColliderFrame> colliders,
                    ClothFrameReport& report);
+  // The self-contact penalties of m_selfContactPairs at x: forces into f, their stiffness times
+  // velocityForProduct into stiffnessTimesVelocity, and the couplings of the solve (h² k JᵀJ)
+  // into m_contactCouplings (SolverSettings::selfContactStiffness).
+  void addSelfContactTerms(const Vec3Array& x, Real h, Vec3Array& f,
+                           const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity);
   // One self-collision pass over the substep from m_stepStartPositions; adds to the report.
   void resolveSelfCollision(Real h, std::span<ColliderFrame> colliders, ClothFrameReport& report);
   // After the collision passes: strain limiting with the collider contacts held along their
@@ -245,6 +251,13 @@ class Cloth final : public DynamicSystem {
   ContactHolds m_contactHolds;                     // with the limiter: this substep's contacts
   std::vector<Real> m_heldInverseMasses;           // 0 also for vertices on two surfaces
   std::vector<SeparationHold> m_heldSeparations;   // self-contacts the limiter holds this round
+  // Self-contacts in the implicit solve (SolverSettings::selfContactStiffness): N/m, 0 when off;
+  // the pairs at this substep's start (separation = thickness), their couplings of the last
+  // linearize(), and whether the last substep's self-collision passes found any contact.
+  Real m_selfContactStiffness = 0;
+  std::vector<SeparationHold> m_selfContactPairs;
+  std::vector<ContactCoupling> m_contactCouplings;
+  bool m_selfContactsLastStep = false;
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
   ClothStageCounters m_stages;                     // this frame's

@@ -573,6 +573,35 @@ void ContactResolver::findProximityContacts(const Vec3Array& start, Real maxThic
   });
 }
 
+const std::vector<ContactResolver::Contact>& ContactResolver::proximityContacts(
+    const Vec3Array& start, std::span<const ContactOwner> owners) {
+  Real maxThickness = 0;
+  for (const ContactOwner& owner : owners) maxThickness = std::max(maxThickness, owner.thickness);
+  if (!m_broadPhaseIsPure) {
+    findProximityContacts(start, maxThickness);
+    return m_contacts;
+  }
+  if (!proximityCacheMatches(start, owners)) {
+    findProximityContacts(start, maxThickness);
+    m_proximityContacts = m_contacts;
+    m_proximityStart = start;
+    m_proximityOwners.assign(owners.begin(), owners.end());
+    m_proximityCached = true;
+  }
+  return m_proximityContacts;
+}
+
+void ContactResolver::findProximityPairs(const Vec3Array& start,
+                                         std::span<const ContactOwner> owners,
+                                         std::vector<SeparationHold>& pairs) {
+  m_owners = owners;
+  pairs.clear();  // keeps its capacity
+  for (const Contact& contact : proximityContacts(start, owners)) {
+    pairs.push_back(SeparationHold{contact.vertices, contact.weights, contact.normal, contact.thickness});
+  }
+  m_owners = {};
+}
+
 SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
                                              std::span<const ContactOwner> owners,
                                              const std::vector<Real>& inverseMasses,
@@ -591,24 +620,9 @@ SelfCollisionReport ContactResolver::resolve(const Vec3Array& start, Real h,
                         m_certificateStart.size() == n &&
                         std::memcmp(start.data(), m_certificateStart.data(), n * sizeof(Vec3)) == 0;
   for (std::size_t i = 0; i < n; ++i) m_velocity[i] = (x[i] - start[i]) / h;
-  Real maxThickness = 0;
-  for (const ContactOwner& owner : owners) maxThickness = std::max(maxThickness, owner.thickness);
-
   // 1. Proximity at the step start: repulsion, inelastic contact and friction.
   if (options.proximity) {
-    const std::vector<Contact>* proximity = &m_contacts;
-    if (!m_broadPhaseIsPure) {
-      findProximityContacts(start, maxThickness);
-    } else {
-      if (!proximityCacheMatches(start, owners)) {
-        findProximityContacts(start, maxThickness);
-        m_proximityContacts = m_contacts;
-        m_proximityStart = start;
-        m_proximityOwners.assign(owners.begin(), owners.end());
-        m_proximityCached = true;
-      }
-      proximity = &m_proximityContacts;
-    }
+    const std::vector<Contact>* proximity = &proximityContacts(start, owners);
     // The impulses, one after the other in pair order (Gauss–Seidel).
     WEFT_PROFILE_ZONE("response");
     const int sweeps = m_colliders.empty() ? 1 : kProximitySweepsWithColliders;

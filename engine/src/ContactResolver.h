@@ -123,6 +123,15 @@ class ContactResolver {
   const std::vector<SeparationHold>& separationHolds() const { return m_separationHolds; }
   void setRecordSeparations(bool record) { m_recordSeparations = record; }
 
+  /// The pairs closer than their thickness at `start` (the proximity stage's contacts, which a
+  /// resolve() from the same start repels), as {vertices, weights, normal, thickness} in pair
+  /// order, into `pairs` (cleared first). With a pure broad phase (setBroadPhaseIsPure) they are
+  /// kept, so the next resolve() of that start reuses them instead of searching again: asked at
+  /// a step's start, before the solve, they cost nothing more (Cloth: the implicit solve's
+  /// self-contact terms, SolverSettings::selfContactStiffness).
+  void findProximityPairs(const Vec3Array& start, std::span<const ContactOwner> owners,
+                          std::vector<SeparationHold>& pairs);
+
   /// Colliders (posed at the end of the step) the next resolve() keeps corrected vertices out
   /// of; empty: none. The span must stay valid during resolve().
   void setColliders(std::span<const ColliderFrame> colliders) { m_colliders = colliders; }
@@ -213,6 +222,10 @@ class ContactResolver {
   // Appends the pairs of `contacts` to m_separationHolds (their separations are set at the end
   // of resolve()).
   void holdContacts(const std::vector<Contact>& contacts);
+  // The proximity contacts of `start`: found now (into m_contacts), or kept from an earlier call of
+  // the same start when the broad phase is pure.
+  const std::vector<Contact>& proximityContacts(const Vec3Array& start,
+                                                std::span<const ContactOwner> owners);
   // The proximity stage's detection: its contacts into m_contacts.
   void findProximityContacts(const Vec3Array& start, Real maxThickness);
   // True when the proximity contacts kept from an earlier resolve() are those of `start` and

@@ -37,6 +37,14 @@ class SelfCollision final : public ContactResolver {
                               const std::vector<Real>& inverseMasses, Vec3Array& x, Vec3Array& v,
                               std::span<const ColliderFrame> colliders = {});
 
+  /// The pairs of the cloth closer than `thickness` at `start` (ContactResolver::
+  /// findProximityPairs), kept for the next resolve() of the same start.
+  void findProximityPairs(const Vec3Array& start, Real thickness, Real friction,
+                          std::vector<SeparationHold>& pairs) {
+    const ContactOwner owner{thickness, friction};
+    ContactResolver::findProximityPairs(start, std::span<const ContactOwner>(&owner, 1), pairs);
+  }
+
   /// Lets the BVHs keep the boxes of parts that moved less than `motion` (m) since their last
   /// refit (Bvh::setRefitMargin; the queries, hence the results, do not change). Negative:
   /// refit every box every time.

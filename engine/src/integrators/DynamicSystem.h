@@ -8,6 +8,7 @@
 #pragma once
 
 #include "solver/BlockSparseMatrix.h"
+#include "solver/ContactCoupling.h"
 #include "solver/FreeVertexMap.h"
 #include "solver/VertexFilter.h"
 
@@ -70,6 +71,12 @@ class DynamicSystem {
                                  VertexFilter& filter) {
     (void)x, (void)v, (void)h, (void)filter;
   }
+
+  /// Rank-one couplings of the system matrix outside its block pattern, from the last
+  /// linearize() (self-contacts, ContactCoupling.h): the full matrix is systemMatrix() +
+  /// Σ coefficient · JᵀJ, their forces are already in f. Indexed by vertex (not by row). Default:
+  /// none.
+  virtual std::span<const ContactCoupling> contactCouplings() const { return {}; }
 
   /// Where the integrator may run its own parallel loops (the linear solve); null: serial.
   virtual TaskSystem* taskSystem() { return nullptr; }

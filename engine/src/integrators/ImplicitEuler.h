@@ -15,7 +15,9 @@
 // otherwise). When the system removes pinned vertices (DynamicSystem::freeVertexMap()) the solve
 // runs over the free rows only, A_ff Δv_f = b_f − A_fp Δv_p; pinned vertices that keep a row are
 // filtered instead (BW98 §5.3: S = 0, target Δv_p), which solves the same equations. Contacts are
-// always filtered. Warm start: the PCG begins from the previous step's Δv, which is close in smooth
+// always filtered. Self-contacts (DynamicSystem::contactCouplings, ContactCoupling.h) are rank-one
+// terms the system adds to A outside its pattern; the PCG applies them matrix-free, and a removed
+// pin in one contributes its known Δv to the right-hand side. Warm start: the PCG begins from the previous step's Δv, which is close in smooth
 // motion.
 #pragma once
 
@@ -48,6 +50,15 @@ class ImplicitEuler final : public Integrator {
   void resizeVertices(Index vertexCount);
   void resizeRows(Index rowCount);
   void solve(DynamicSystem& system, IntegratorReport& report);
+  // The system's active contact couplings renumbered into rows (m_rowCouplings), their forces
+  // added to the row right-hand side (h (F + h K v), or h F for a Newton iteration) and, with
+  // removedPins, their coupling to removed pins' known Δv (m_deltaV) taken to it.
+  void gatherCouplings(const DynamicSystem& system, const FreeVertexMap& map, bool removedPins,
+                       Real h, bool newton);
+  // Sets each coupling active when its normal force at the end of the step, in the solve's
+  // linear model, pushes (h F_end = impulse − coefficient · J Δv > 0, Δv = m_deltaV by vertex);
+  // true when the active set changed.
+  bool updateActiveCouplings(const DynamicSystem& system, Real h);
 
   SolverSettings m_settings;
   FilteredPcg m_pcg;
@@ -64,6 +75,8 @@ class ImplicitEuler final : public Integrator {
   Vec3Array m_iteratePosition;   // x_k
   Vec3Array m_iterateVelocity;   // v_k
   Vec3Array m_prescribedPosition, m_prescribedVelocity;
+  std::vector<ContactCoupling> m_rowCouplings;  // the system's active contact couplings, by row
+  std::vector<char> m_couplingActive;           // per system coupling: 1 while it pushes
   bool m_hasWarmStart = false;
 };
 

@@ -49,23 +49,27 @@ Mat3 filteredInverse(const Mat3& diagonal, const VertexFilter& filter, Index ver
   return Mat3::Zero();
 }
 
+/// P̃_i⁻¹ of one vertex whose diagonal block is `diagonal`.
+Mat3 preconditionerBlock(const Mat3& diagonal, const VertexFilter& filter, Index vertex) {
+  Mat3 inverse = filteredInverse(diagonal, filter, vertex);
+  // A singular diagonal block (impossible for SPD A, possible for a broken assembly) gives an
+  // infinite inverse; fall back to scalar Jacobi so the preconditioner itself stays finite. A NaN
+  // block fails the test too, but its NaN still reaches the residual through the SpMV.
+  if (!inverse.allFinite()) {
+    const Real meanDiagonal = diagonal.trace() / 3;
+    inverse = (meanDiagonal > 0 && std::isfinite(meanDiagonal) ? 1 / meanDiagonal : Real(1)) *
+              filter.projection(vertex);
+  }
+  // Cofactor inverses of a symmetric block can differ from symmetric in the last bit; CG wants a
+  // symmetric preconditioner, so average the two triangles.
+  return Real(0.5) * (inverse + inverse.transpose());
+}
+
 /// P̃_i⁻¹ for every vertex of the range.
 void buildPreconditionerRange(Index begin, Index end, const BlockSparseMatrix& A,
                               const VertexFilter& filter, std::vector<Mat3>& inverseDiagonal) {
   for (Index vertex = begin; vertex < end; ++vertex) {
-    const Mat3& diagonal = A.block(A.diagonalSlot(vertex));
-    Mat3 inverse = filteredInverse(diagonal, filter, vertex);
-    // A singular diagonal block (impossible for SPD A, possible for a broken assembly) gives an
-    // infinite inverse; fall back to scalar Jacobi so the preconditioner itself stays finite. A NaN
-    // block fails the test too, but its NaN still reaches the residual through the SpMV.
-    if (!inverse.allFinite()) {
-      const Real meanDiagonal = diagonal.trace() / 3;
-      inverse = (meanDiagonal > 0 && std::isfinite(meanDiagonal) ? 1 / meanDiagonal : Real(1)) *
-                filter.projection(vertex);
-    }
-    // Cofactor inverses of a symmetric block can differ from symmetric in the last bit; CG wants a
-    // symmetric preconditioner, so average the two triangles.
-    inverseDiagonal[vertex] = Real(0.5) * (inverse + inverse.transpose());
+    inverseDiagonal[vertex] = preconditionerBlock(A.block(A.diagonalSlot(vertex)), filter, vertex);
   }
 }
 
@@ -102,13 +106,17 @@ PassSums rightHandSideRange(Index begin, Index end, const Vec3Array& b, const Ve
   return sum;
 }
 
-/// r = S(b − A x), s = P̃⁻¹ r over the range; returns Σ rᵀs, the stopping norm² and ‖x‖²_M.
+/// r = S(b − A x − y), s = P̃⁻¹ r over the range, y = E x the contact couplings' product (null:
+/// none); returns Σ rᵀs, the stopping norm² and ‖x‖²_M.
 PassSums residualRange(Index begin, Index end, const BlockSparseMatrix& A, const Vec3Array& b,
                        const VertexFilter& filter, const std::vector<Mat3>& inverseDiagonal,
-                       const MassWeights& weights, const Vec3Array& x, Vec3Array& r, Vec3Array& s) {
+                       const MassWeights& weights, const Vec3Array& x, Vec3Array& r, Vec3Array& s,
+                       const Vec3Array* coupled) {
   PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
-    r[vertex] = filter.filter(vertex, b[vertex] - A.multiplyRow(vertex, x));
+    Vec3 rest = b[vertex] - A.multiplyRow(vertex, x);
+    if (coupled) rest -= (*coupled)[vertex];
+    r[vertex] = filter.filter(vertex, rest);
     s[vertex].noalias() = inverseDiagonal[vertex] * r[vertex];
     sum.cg += r[vertex].dot(s[vertex]);
     sum.stop += stopTerm(weights, vertex, r[vertex], s[vertex]);
@@ -305,6 +313,10 @@ void FilteredPcg::resize(Index vertexCount) {
   m_stopMass.assign(vertexCount, 0);
   m_snapshot.assign(vertexCount, Vec3::Zero());
   m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
+  m_couplingDiagonal.assign(vertexCount, Mat3::Zero());
+  m_couplingProduct.assign(vertexCount, Vec3::Zero());
+  m_couplingMark.assign(vertexCount, 0);
+  m_couplingRows.clear();
 }
 
 template <typename Kernel>
@@ -383,6 +395,7 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
                                       PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
                                       TaskSystem* tasks) {
   m_tasks = tasks;
+  m_couplings = {};
   const Index vertexCount = A.blockRows();
   if (m_residual.size() != vertexCount) resize(vertexCount);
   z.resize(vertexCount);
@@ -403,12 +416,56 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
   backwardSweep(filter, m_preconditioned, z, m_residual);  // z = P_U⁻¹ D̃ w
 }
 
+void FilteredPcg::prepareCouplings(const BlockSparseMatrix& A, const VertexFilter& filter) {
+  for (Index row : m_couplingRows) {
+    m_couplingDiagonal[row].setZero();
+    m_couplingProduct[row].setZero();
+    m_couplingMark[row] = 0;
+  }
+  m_couplingRows.clear();  // keeps its capacity: grows only with the most contacts seen
+  for (const ContactCoupling& term : m_couplings) {
+    for (int k = 0; k < 4; ++k) {
+      const Index row = term.rows[k];
+      if (row == kInvalidIndex) continue;
+      if (!m_couplingMark[row]) {
+        m_couplingMark[row] = 1;
+        m_couplingRows.push_back(row);
+      }
+      m_couplingDiagonal[row] += couplingDiagonalBlock(term, k);
+    }
+  }
+  // D̃' = blocks of A + E: the rows a coupling touches get the inverse of their summed block.
+  for (Index row : m_couplingRows) {
+    m_inverseDiagonal[row] =
+        preconditionerBlock(A.block(A.diagonalSlot(row)) + m_couplingDiagonal[row], filter, row);
+  }
+}
+
+const Vec3Array* FilteredPcg::couplingProduct(const Vec3Array& x, bool offDiagonalOnly) {
+  if (m_couplings.empty()) return nullptr;
+  for (Index row : m_couplingRows) m_couplingProduct[row].setZero();
+  addCouplingProduct(m_couplings, x, m_couplingProduct, offDiagonalOnly);
+  return &m_couplingProduct;
+}
+
+Real FilteredPcg::addCouplingDiagonal(const VertexFilter& filter, const Vec3Array& r, Vec3Array& s) {
+  Real sum = 0;
+  for (Index row : m_couplingRows) {
+    const Vec3 extra = filter.filter(row, m_couplingDiagonal[row] * r[row]);
+    s[row] += extra;
+    sum += r[row].dot(extra);
+  }
+  return sum;
+}
+
 SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
                                const VertexFilter& filter, const PcgSettings& settings,
                                Vec3Array& deltaV, TaskSystem* tasks,
-                               std::span<const Real> masses) {
+                               std::span<const Real> masses,
+                               std::span<const ContactCoupling> couplings) {
   SolveReport report;
   m_tasks = tasks;
+  m_couplings = {};
   const Index vertexCount = A.blockRows();
   const bool velocityTest = settings.stopping == PcgStopping::VelocityError;
   // Validated rather than asserted: the contract says a mismatch is reported, not undefined.
@@ -417,6 +474,15 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
     report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
     report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
     return report;
+  }
+  for (const ContactCoupling& term : couplings) {
+    for (Index row : term.rows) {
+      if (row != kInvalidIndex && row >= vertexCount) {
+        report.relativeResidual = std::numeric_limits<Real>::quiet_NaN();
+        report.residualNorm = std::numeric_limits<Real>::quiet_NaN();
+        return report;
+      }
+    }
   }
   if (m_residual.size() != vertexCount) resize(vertexCount);  // allocates only on a size change
   bool warmStart = settings.warmStart;
@@ -432,6 +498,8 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   forEachBlock(vertexCount, [&](Index begin, Index end) {
     buildPreconditionerRange(begin, end, A, filter, m_inverseDiagonal);
   });
+  m_couplings = couplings;
+  prepareCouplings(A, filter);
   const bool gaussSeidel = settings.preconditioner == PreconditionerKind::MulticolorGaussSeidel;
   // The colouring depends on the pattern only: rebuilt (allocating) when the topology changes.
   if (gaussSeidel) prepareGaussSeidel(A);
@@ -466,9 +534,13 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
                                return rightHandSideRange(begin, end, b, filter, m_inverseDiagonal,
                                                          weights, r, s);
                              })
-             : sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-                 return residualRange(begin, end, A, b, filter, m_inverseDiagonal, weights, c, r, s);
-               }))
+             : [&] {
+                 const Vec3Array* coupled = couplingProduct(c);
+                 return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+                   return residualRange(begin, end, A, b, filter, m_inverseDiagonal, weights, c, r,
+                                        s, coupled);
+                 });
+               }())
             .cg;
   }
 
@@ -476,8 +548,10 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
                [&](Index begin, Index end) { startRange(begin, end, filter, warmStart, deltaV); });
   // start.stop drives the stopping rule; start.cg = rᵀs = rᵀP⁻¹r drives CG. They are one number
   // for the relative-residual test with block Jacobi (s = D̃⁻¹r).
+  const Vec3Array* coupled = couplingProduct(deltaV);
   const PassSums start = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-    return residualRange(begin, end, A, b, filter, m_inverseDiagonal, weights, deltaV, r, s);
+    return residualRange(begin, end, A, b, filter, m_inverseDiagonal, weights, deltaV, r, s,
+                         coupled);
   });
   if (!warmStart) referenceDelta = start.cg;
 
@@ -581,9 +655,17 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
         directionRange(begin, end, beta, filter, s, c);
       });
     }
-    const Real curvature = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    Real curvature = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
       return filteredProductRange(begin, end, A, filter, c, q);
     });
+    // q += S E c over the rows the contact couplings touch (serially, in a fixed order).
+    if (const Vec3Array* coupled = couplingProduct(c)) {
+      for (Index row : m_couplingRows) {
+        const Vec3 extra = filter.filter(row, (*coupled)[row]);
+        q[row] += extra;
+        curvature += c[row].dot(extra);
+      }
+    }
     // cᵀAc ≤ 0 means A is not positive definite on the free subspace (or q holds a NaN): CG has
     // broken down. Stop before touching Δv, so it keeps the last finite iterate.
     if (!(curvature > 0) || !std::isfinite(curvature)) {
@@ -633,6 +715,7 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   Real delta = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
     return diagonalRange(begin, end, A, filter, r, s);
   });
+  delta += addCouplingDiagonal(filter, r, s);  // ŝ = D̃' r̂ with the couplings' diagonal blocks
   forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
   // ‖r‖²_{M⁻¹} = r̂ᵀD̃r̂ = delta (M the SGS preconditioner) falls with CG's iterations; its ratio to
   // the start scales the start's exact stopping norm into an estimate, and the exact norm (one
@@ -676,6 +759,10 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
       });
     }
     backwardSweep(filter, c, t, w);
+    // u = ĉ − D̃' t + S E_off t: the couplings' off-diagonal blocks, which the sweeps do not hold.
+    if (const Vec3Array* coupled = couplingProduct(t, /*offDiagonalOnly=*/true)) {
+      for (Index row : m_couplingRows) w[row] += filter.filter(row, (*coupled)[row]);
+    }
     const Real curvature = forwardSweep<true>(filter, c, t, w);
     // ĉᵀÂĉ ≤ 0: breakdown (A not positive definite on the free subspace, or a NaN). Δv keeps the
     // last finite iterate; the report gets that iterate's exact residual.
@@ -699,7 +786,7 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
       return transformedUpdateRange(begin, end, alpha, A, filter, weights, t, w, deltaV, r, s,
                                     snapshot);
     });
-    delta = sums.cg;
+    delta = sums.cg + addCouplingDiagonal(filter, r, s);
     solutionSquaredNorm = sums.scale;
     progress = snapshot ? sums.progress : Real(-1);
     ++report.iterations;

@@ -86,6 +86,20 @@
 //   memory bandwidth; three sweeps per iteration, one of them the SpMV (Gauss–Seidel: four, two
 //   of them the half-sweeps; its curvature sum is taken colour by colour, fixed blocks within a
 //   colour, colours in order).
+// - Contact couplings (ContactCoupling.h). solve() may take a list of rank-one terms
+//   E = Σ coefficient · JᵀJ outside A's block pattern (self-contacts) and then solves (A + E)Δv = b,
+//   matrix-free: E = E_diag + E_off, its diagonal blocks E_ii and its coupling blocks.
+//   Block Jacobi: D̃' = blocks of A + E_ii (the touched rows' inverses rebuilt), and the SpMV adds
+//   S E c, computed serially in list order over the touched rows after the parallel pass.
+//   Gauss–Seidel: the sweeps run on Ã' = L̃ + D̃' + L̃ᵀ + S E_off S, with P_L = D̃' + L̃ (L̃ from A
+//   only). With t = P_L⁻ᵀ ĉ, Ã' t = P_L t + (ĉ − D̃' t) + S E_off S t, so
+//   Â ĉ = t + P_L⁻¹(ĉ − D̃' t + S E_off t): the backward sweep leaves u = ĉ − D̃' t as before (its
+//   identity uses D̃' itself), and S E_off t is added to u before the forward sweep; ŝ = D̃' r̂ gets
+//   S E_ii r̂ added on the touched rows. M = P_L D̃'⁻¹ P_Lᵀ stays SPD, so this is PCG on Ã' with an
+//   SGS preconditioner that holds E's diagonal blocks but not its couplings. The residuals
+//   r = S(b − (A + E)Δv) take E Δv the same way. Every coupling operation is serial over the
+//   terms or the touched rows in a fixed order: the same bits on any thread count. A ⪰ M still
+//   holds (E ⪰ 0), so the velocity test's bound is unchanged.
 // - No allocation in solve(): all scratch is sized by resize() (the Gauss–Seidel colouring and
 //   packed blocks on the first solve of a pattern). Non-finite input (NaN or inf in
 //   b or in A where it reaches the free subspace) ends the solve with converged = false; deltaV
@@ -93,6 +107,7 @@
 #pragma once
 
 #include <solver/BlockSparseMatrix.h>
+#include <solver/ContactCoupling.h>
 #include <solver/MulticolorOrdering.h>
 #include <solver/VertexFilter.h>
 
@@ -192,16 +207,21 @@ class FilteredPcg {
   /// solution. Allocates only if resize() was not called with this vertex count.
   /// `tasks` runs the sweeps over the reduction blocks (null: serial); the blocks and the order
   /// their partial sums are combined in do not depend on it, so neither do the bits.
+  /// couplings: rank-one terms added to A (rows of A, kInvalidIndex entries skipped; the rows of
+  /// one term distinct); the solve is then of (A + Σ coefficient·JᵀJ) Δv = b (header, "Contact
+  /// couplings"). A row out of range is reported like a size mismatch. The touched-row list grows
+  /// (allocates) only when more rows are coupled than in any earlier solve.
   SolveReport solve(const BlockSparseMatrix& A, const Vec3Array& b, const VertexFilter& filter,
                     const PcgSettings& settings, Vec3Array& deltaV, TaskSystem* tasks = nullptr,
-                    std::span<const Real> masses = {});
+                    std::span<const Real> masses = {},
+                    std::span<const ContactCoupling> couplings = {});
 
   /// Colours of A's rows for the Gauss–Seidel order (MulticolorOrdering::build), used by every
   /// later solve while they separate every coupled pair of A's pattern (else the pattern is
   /// coloured); empty: colour the pattern. The span must stay valid until the next call.
   void setRowColors(std::span<const Index> rowColors) { m_rowColors = rowColors; }
 
-  /// z = P̃⁻¹ r: the preconditioner `kind` built from A and filter exactly as solve() builds it
+  /// z = P̃⁻¹ r: the preconditioner `kind` built from A (no couplings) and filter exactly as solve() builds it
   /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r). r should lie in the free subspace
   /// (S r = r); z does, exactly zero at fixed vertices. For tests and diagnostics; sizes as solve().
   void applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
@@ -230,6 +250,15 @@ class FilteredPcg {
   /// Orders A's rows (m_rowColors, else A's pattern) if the pattern or colours are new (allocates
   /// then) and packs its off-diagonal blocks in sweep order (every solve: the values change).
   void prepareGaussSeidel(const BlockSparseMatrix& A);
+
+  /// Collects the rows the couplings touch and their diagonal blocks E_ii, and rebuilds those
+  /// rows' preconditioner blocks from A_ii + E_ii (header, "Contact couplings").
+  void prepareCouplings(const BlockSparseMatrix& A, const VertexFilter& filter);
+  /// y = E x (E_off x when offDiagonalOnly) on the touched rows (zero elsewhere), serially;
+  /// null when there are no couplings.
+  const Vec3Array* couplingProduct(const Vec3Array& x, bool offDiagonalOnly = false);
+  /// s += S E_ii r on the touched rows; returns Σ rᵀ S E_ii r over them, in row-list order.
+  Real addCouplingDiagonal(const VertexFilter& filter, const Vec3Array& r, Vec3Array& s);
 
   /// The stopping rule of one solve (header, "Stopping").
   struct Stopping {
@@ -277,6 +306,11 @@ class FilteredPcg {
   std::vector<Real> m_stopMass;         ///< kg, m_i of the velocity test (0 on fixed vertices)
   std::vector<Real> m_inverseMass;      ///< 1/kg, 1/m_i of the velocity test (0 on fixed vertices)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
+  std::span<const ContactCoupling> m_couplings;  ///< the current solve's couplings
+  std::vector<Index> m_couplingRows;    ///< rows the couplings touch, in first-seen order
+  std::vector<char> m_couplingMark;     ///< 1 on the rows of m_couplingRows
+  std::vector<Mat3> m_couplingDiagonal; ///< E_ii on the touched rows, zero elsewhere
+  Vec3Array m_couplingProduct;          ///< E x (or E_off x) on the touched rows, zero elsewhere
 };
 
 }  // namespace weft
