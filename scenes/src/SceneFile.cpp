@@ -364,7 +364,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
                     "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "cgTolerance", "cgStopping",
-                    "cgMaxIterations", "warmStart"});
+                    "cgMaxIterations", "warmStart", "selfContactStiffness"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
     const std::optional<IntegratorKind> kind = integratorFromName(name);
@@ -388,6 +388,8 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
                   "cloth sizes");
   reader.readReal(object, path, "pinTeleportAngle", s.pinTeleportAngle, Range::NonNegative, "rad");
+  reader.readReal(object, path, "selfContactStiffness", s.selfContactStiffness, Range::NonNegative,
+                  "multiples of the stretch stiffness");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
   reader.readReal(object, path, "cgTolerance", s.cgTolerance, Range::Positive,
                   "relative, in the sense of cgStopping");
