@@ -245,8 +245,18 @@ std::string describeConfig(const RunResult& run) {
   std::ostringstream text;
   text << run.config.method << " h=1/" << std::lround(run.substeps / CurtainScene::kFrameDt);
   if (run.config.solver.integrator == IntegratorKind::ImplicitEuler) {
-    text << " tol=" << formatTolerance(run.config.solver.cgTolerance)
-         << (run.config.solver.warmStart ? " warm" : " cold");
+    text << " tol=" << formatTolerance(run.config.solver.cgTolerance);
+    // The defaults name their stopping test (the series say it in their method name) and the
+    // contact-aware tightening (SolverSettings::tightCgTolerance: the residual tolerance of hard
+    // substeps, after a self-collision pass with at least that many contacts per vertex).
+    if (run.config.isDefaults) {
+      text << (run.config.solver.cgStopping == PcgStopping::VelocityError ? " verr" : " residual");
+    }
+    if (run.config.solver.tightCgTolerance > 0) {
+      text << " tight=" << formatTolerance(run.config.solver.tightCgTolerance) << "@"
+           << run.config.solver.tightSelfContactDensity;
+    }
+    text << (run.config.solver.warmStart ? " warm" : " cold");
   }
   if (run.config.solver.substeps == 0) text << " (auto)";
   if (run.config.isDefaults) text << " [defaults]";
@@ -292,6 +302,7 @@ std::vector<SweepConfig> sweepConfigs(const ErrorTimeOptions& options) {
           // The implicit series are the residual test, named so; the default is the velocity
           // error, which the -verr series sweeps.
           config.solver.cgStopping = PcgStopping::RelativeResidual;
+          config.solver.tightCgTolerance = 0;  // every substep to cgTolerance: a uniform grid
           config.solver.warmStart = warm;
           configs.push_back(config);
           // The same step with the velocity-error stopping test (SolverSettings::cgStopping); in
@@ -489,6 +500,7 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
   referenceConfig.solver.newtonIterations = options.referenceNewtonIterations;
   referenceConfig.solver.cgTolerance = options.referenceCgTolerance;
   referenceConfig.solver.cgStopping = PcgStopping::RelativeResidual;  // the issue's "residual ≤ 1e-10"
+  referenceConfig.solver.tightCgTolerance = 0;  // every substep to the reference's tolerance
   referenceConfig.solver.cgMaxIterations = 5000;
   std::ostringstream keyText;
   keyText << std::setprecision(17) << "weft-error-time reference v1; curtain size " << size

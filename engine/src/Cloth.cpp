@@ -170,6 +170,27 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
     return "cloth settings: forceModel = " + std::to_string(int(settings.forceModel)) +
            " is not a ForceModel; use BaraffWitkin or MassSpring";
   }
+  if (!(solver.tightCgTolerance >= 0 && solver.tightCgTolerance < 1)) {
+    std::ostringstream text;
+    text << "cloth settings: solver.tightCgTolerance = " << solver.tightCgTolerance
+         << " (relative residual): must be at least 0 and below 1 (0 = hard substeps are not "
+            "tightened)";
+    return text.str();
+  }
+  if (!(solver.tightPinTravel > 0)) {
+    std::ostringstream text;
+    text << "cloth settings: solver.tightPinTravel = " << solver.tightPinTravel
+         << " (mean edge lengths per substep): must be greater than 0 (infinity = pins never "
+            "make a substep hard; tightCgTolerance = 0 turns the tightening off)";
+    return text.str();
+  }
+  if (!(solver.tightSelfContactDensity > 0)) {
+    std::ostringstream text;
+    text << "cloth settings: solver.tightSelfContactDensity = " << solver.tightSelfContactDensity
+         << " (self-contacts per vertex): must be greater than 0 (infinity = self-contact never "
+            "makes a substep hard; tightCgTolerance = 0 turns the tightening off)";
+    return text.str();
+  }
   if (solver.cgMaxIterations < 1) return "cloth settings: solver.cgMaxIterations must be at least 1";
   if (solver.newtonIterations < 0) return "cloth settings: solver.newtonIterations must be at least 0";
   if (solver.maxSubsteps < 1) return "cloth settings: solver.maxSubsteps must be at least 1";
@@ -711,6 +732,13 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
                                  std::span<ColliderFrame> colliders, ClothFrameReport& report) {
   const Real h = frameDt / substeps;
   const RigidMotion* frameStart = m_frameStartMotions.data();
+  // A pin yanked far in each substep makes every substep of the frame hard (tightPinTravel);
+  // pins move on straight lines through the frame, so each substep has 1/substeps of the travel.
+  Real pinTravel = 0;
+  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
+    pinTravel = std::max(pinTravel, (m_pinEnd[k] - m_pinStart[k]).norm());
+  }
+  const bool yanked = pinTravel >= m_settings.solver.tightPinTravel * m_meanEdgeLength * Real(substeps);
   for (Index substep = 0; substep < substeps; ++substep) {
     IntegratorReport substepReport;
     for (std::size_t k = 0; k < colliders.size(); ++k) {
@@ -722,6 +750,15 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
     if (!colliders.empty() || m_selfCollision) {
       m_stepStartPositions = m_positions;
       m_stepStartVelocities = m_velocities;
+    }
+    if (m_settings.solver.tightCgTolerance > 0) {
+      // Contact-aware accuracy (SolverSettings::tightCgTolerance): jammed or yanked, solve tighter.
+      if (m_jammed || yanked) {
+        m_integrator->setSolveAccuracy(std::min(m_frameTolerance, m_settings.solver.tightCgTolerance),
+                                       PcgStopping::RelativeResidual);
+      } else {
+        m_integrator->setSolveAccuracy(m_frameTolerance, m_settings.solver.cgStopping);
+      }
     }
     // Self-contacts in the solve (SolverSettings::selfContactStiffness): the pairs in contact at
     // the step start, looked for when the last substep had self-contacts. The self-collision
@@ -763,7 +800,14 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
                                                  m_stepStartPositions, m_positions,
                                                  m_settings.material.thickness));
     if (m_selfCollision && !selfCollisionNeeded) ++m_stages.selfCollisionSkipped;
-    if (selfCollisionNeeded) resolveSelfCollision(h, colliders, report);
+    Index selfContacts = 0;  // of this substep's first self pass: the jam measure
+    if (selfCollisionNeeded) {
+      const Index before = report.selfCollision.proximityContacts + report.selfCollision.impacts;
+      resolveSelfCollision(h, colliders, report);
+      selfContacts = report.selfCollision.proximityContacts + report.selfCollision.impacts - before;
+    }
+    m_jammed = Real(selfContacts) >=
+               m_settings.solver.tightSelfContactDensity * Real(vertexCount());
     if (m_strainLimiter && (contacts > 0 || selfCollisionNeeded)) {
       edgesOverLimit = limitStrainInContact(h, colliders, selfCollisionNeeded, edgesOverLimit, report);
     }
@@ -845,6 +889,7 @@ void Cloth::save(SavedState& out) const {
   out.quietFrames = m_quietFrames;
   out.sleepFingerprint = m_sleepFingerprint;
   out.potentialEnergy = m_lastPotential;
+  out.jammed = m_jammed;
 }
 
 void Cloth::restore(const SavedState& in) {
@@ -858,6 +903,7 @@ void Cloth::restore(const SavedState& in) {
   m_quietFrames = in.quietFrames;
   m_sleepFingerprint = in.sleepFingerprint;
   m_lastPotential = in.potentialEnergy;
+  m_jammed = in.jammed;
 }
 
 std::uint64_t Cloth::colliderFingerprint(std::span<const ColliderFrame> colliders, Real frameDt,
@@ -970,9 +1016,11 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
                         frameDt / substeps > m_stableStep;
   }
   if (predictedUnstable) report.status |= StepStatus::Unstable;
+  m_frameTolerance = plan.cgTolerance > 0 ? plan.cgTolerance : m_settings.solver.cgTolerance;
   m_integrator->setSolveLimits(
-      plan.cgTolerance > 0 ? plan.cgTolerance : m_settings.solver.cgTolerance,
+      m_frameTolerance,
       plan.cgMaxIterations > 0 ? plan.cgMaxIterations : m_settings.solver.cgMaxIterations);
+  m_frameStartJammed = m_jammed;
   m_nearColliders.reserve(colliders.size());  // allocates only when colliders are added
 
   m_savedPositions = m_positions;
@@ -1011,6 +1059,7 @@ ClothFrameReport Cloth::stepFrame(Real t, Real frameDt, std::span<ColliderFrame>
     report.maxStrain = startStrain;  // back where the frame started
     report.kineticEnergy = startKinetic;
     m_integrator->reset();  // the failed attempt's Δv is no warm start
+    m_jammed = m_frameStartJammed;
     report.status |= StepStatus::Unstable;
     if (attempt == kMaxRetries) {
       report.status |= StepStatus::RolledBack;

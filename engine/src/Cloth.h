@@ -132,6 +132,7 @@ class Cloth final : public DynamicSystem {
     Index quietFrames = 0;
     std::uint64_t sleepFingerprint = 0;
     Real potentialEnergy = 0;  // J, what a sleeping cloth reports (m_lastPotential)
+    bool jammed = false;       // m_jammed: the next substep is hard (tightCgTolerance)
   };
   void save(SavedState& out) const;
   /// Restores a save of this cloth (sizes checked by the caller).
@@ -264,6 +265,11 @@ class Cloth final : public DynamicSystem {
   bool m_sleeping = false, m_wakeRequested = false;
   Index m_quietFrames = 0;
   std::uint64_t m_sleepFingerprint = 0;
+  // Contact-aware accuracy (SolverSettings::tightCgTolerance): whether the last self-collision
+  // pass was heavy, so the next substep is tightened; carried across frames, and its frame-start
+  // value for a retry. m_frameTolerance: this frame's tolerance (the plan's or cgTolerance).
+  bool m_jammed = false, m_frameStartJammed = false;
+  Real m_frameTolerance = 0;
   std::vector<Real> m_inverseMasses;               // 0 for pinned vertices
   std::span<const ColliderFrame> m_colliders;  // this substep's colliders
   Vec3Array m_stepStartPositions, m_stepStartVelocities;

@@ -363,7 +363,8 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   if (!reader.expectObject(object, path, "solver settings")) return;
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
-                    "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "cgTolerance", "cgStopping",
+                    "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "tightCgTolerance",
+                    "tightSelfContactDensity", "tightPinTravel", "cgTolerance", "cgStopping",
                     "cgMaxIterations", "warmStart", "selfContactStiffness"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
@@ -391,6 +392,12 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readReal(object, path, "selfContactStiffness", s.selfContactStiffness, Range::NonNegative,
                   "multiples of the stretch stiffness");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
+  reader.readReal(object, path, "tightCgTolerance", s.tightCgTolerance, Range::NonNegative,
+                  "relative residual, 0 = off");
+  reader.readReal(object, path, "tightSelfContactDensity", s.tightSelfContactDensity,
+                  Range::Positive, "self-contacts per vertex");
+  reader.readReal(object, path, "tightPinTravel", s.tightPinTravel, Range::Positive,
+                  "mean edge lengths per substep");
   reader.readReal(object, path, "cgTolerance", s.cgTolerance, Range::Positive,
                   "relative, in the sense of cgStopping");
   std::string stopping;

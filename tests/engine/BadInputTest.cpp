@@ -160,6 +160,14 @@ TEST_F(BadInput, BadSolverSettings) {
   refuse([](SolverSettings& s) { s.maxImplicitStep = kNaN; }, "solver.maxImplicitStep");
   refuse([](SolverSettings& s) { s.cgTolerance = -1e-3; }, "solver.cgTolerance");
   refuse([](SolverSettings& s) { s.cgMaxIterations = 0; }, "solver.cgMaxIterations");
+  // The contact-aware tightening: a relative residual in [0, 1), thresholds above 0.
+  refuse([](SolverSettings& s) { s.tightCgTolerance = -1e-3; }, "solver.tightCgTolerance");
+  refuse([](SolverSettings& s) { s.tightCgTolerance = 1; }, "solver.tightCgTolerance");
+  refuse([](SolverSettings& s) { s.tightCgTolerance = kNaN; }, "solver.tightCgTolerance");
+  refuse([](SolverSettings& s) { s.tightSelfContactDensity = 0; }, "solver.tightSelfContactDensity");
+  refuse([](SolverSettings& s) { s.tightSelfContactDensity = kNaN; }, "solver.tightSelfContactDensity");
+  refuse([](SolverSettings& s) { s.tightPinTravel = -1; }, "solver.tightPinTravel");
+  refuse([](SolverSettings& s) { s.tightPinTravel = kNaN; }, "solver.tightPinTravel");
   refuse([](SolverSettings& s) { s.newtonIterations = -1; }, "solver.newtonIterations");
   refuse([](SolverSettings& s) { s.maxSubsteps = 0; }, "solver.maxSubsteps");
   refuse([](SolverSettings& s) { s.integrator = IntegratorKind(17); }, "solver.integrator");

@@ -62,7 +62,8 @@ TEST(SceneFile, PresetThenFieldsOverrideIt) {
   Result<SceneDescription> scene = loadSceneText(R"({"version": 1, "cloths": [{"grid": {},
       "material": {"preset": "denim", "friction": 0.7},
       "solver": {"integrator": "rk4", "substeps": 12, "pinTeleportDistance": 0,
-                 "cgStopping": "velocityError"},
+                 "cgStopping": "relativeResidual", "tightCgTolerance": 1e-4,
+                 "tightSelfContactDensity": 0.1, "tightPinTravel": 2},
       "forceModel": "mass-spring"}]})");
   ASSERT_TRUE(scene.ok()) << scene.error().message;
   const ClothSettings& settings = scene->cloths[0].settings;
@@ -71,7 +72,10 @@ TEST(SceneFile, PresetThenFieldsOverrideIt) {
   EXPECT_EQ(settings.solver.integrator, IntegratorKind::RungeKutta4);
   EXPECT_EQ(settings.solver.substeps, 12u);
   EXPECT_EQ(settings.solver.pinTeleportDistance, 0.0);
-  EXPECT_EQ(settings.solver.cgStopping, PcgStopping::VelocityError);
+  EXPECT_EQ(settings.solver.cgStopping, PcgStopping::RelativeResidual);
+  EXPECT_EQ(settings.solver.tightCgTolerance, 1e-4);
+  EXPECT_EQ(settings.solver.tightSelfContactDensity, 0.1);
+  EXPECT_EQ(settings.solver.tightPinTravel, 2.0);
   EXPECT_EQ(settings.forceModel, ForceModel::MassSpring);
 }
 
@@ -162,6 +166,10 @@ INSTANTIATE_TEST_SUITE_P(
                  "/cloths/0/solver/integrator", "implicit-euler"},
         BadScene{"UnknownCgStopping", CLOTH(R"(, "solver": {"cgStopping": "energy"})"),
                  "/cloths/0/solver/cgStopping", "relativeResidual, velocityError"},
+        BadScene{"NegativeTightCgTolerance", CLOTH(R"(, "solver": {"tightCgTolerance": -1e-3})"),
+                 "/cloths/0/solver/tightCgTolerance", "must not be negative"},
+        BadScene{"ZeroTightSelfContactDensity", CLOTH(R"(, "solver": {"tightSelfContactDensity": 0})"),
+                 "/cloths/0/solver/tightSelfContactDensity", "greater than 0 (self-contacts per vertex)"},
         BadScene{"NegativeTeleportDistance", CLOTH(R"(, "solver": {"pinTeleportDistance": -1})"),
                  "/cloths/0/solver/pinTeleportDistance", "cloth sizes"},
         BadScene{"WrongVectorLength", CLOTH(R"(, "translation": [1, 2])"),

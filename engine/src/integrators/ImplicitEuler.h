@@ -42,6 +42,10 @@ class ImplicitEuler final : public Integrator {
     m_settings.cgTolerance = tolerance;
     m_settings.cgMaxIterations = maxIterations;
   }
+  void setSolveAccuracy(Real tolerance, PcgStopping stopping) override {
+    m_settings.cgTolerance = tolerance;
+    m_settings.cgStopping = stopping;
+  }
   void saveCarriedState(Vec3Array& out) const override;
   void restoreCarriedState(const Vec3Array& in) override;
   void rotateCarriedState(const Mat3& rotation) override;

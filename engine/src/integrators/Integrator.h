@@ -45,6 +45,9 @@ class Integrator {
   /// Sets the linear solver's relative tolerance and iteration cap for the following steps (a
   /// frame budget's plan); methods without a linear solve ignore it.
   virtual void setSolveLimits(Real tolerance, int maxIterations) { (void)tolerance, (void)maxIterations; }
+  /// Sets the tolerance and the stopping test of the following steps' solves, keeping the
+  /// iteration cap (the contact-aware accuracy, SolverSettings::tightCgTolerance, per substep).
+  virtual void setSolveAccuracy(Real tolerance, PcgStopping stopping) { (void)tolerance, (void)stopping; }
   /// Forgets warm-start data (after a teleport or a restore).
   virtual void reset() {}
   /// State carried from one step to the next that changes results (the implicit method's Δv
