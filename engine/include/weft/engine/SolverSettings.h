@@ -192,7 +192,9 @@ struct SolverSettings {
   /// 6.1e-4 J; 0.1, 0.3 and 3 settled 9, 9 and 9: no clear optimum), at cgTolerance 1e-4 in 9 of
   /// 9 drop heights against 2; stress scene 10 dragged (weft-teleport-perturb
   /// --pin-teleport-distance 0) 0 of 24 runs fail against 6, 0 of 48 with --sleep-variants as
-  /// before. Why it is off: the curtain's CG iterations per frame go from 20.6 to 52.9 (max 305)
+  /// before. (These figures are with every solve at the relative residual 1e-3, the default
+  /// before the contact-aware accuracy; with today's default, loose between hard substeps, the
+  /// dragged pins fail 4 of 24 with it on and 6 of 24 off: `--former-default-solve` gives 0.) Why it is off: the curtain's CG iterations per frame go from 20.6 to 52.9 (max 305)
   /// and its p95 frame time doubles (the Gauss–Seidel preconditioner holds a contact's diagonal
   /// blocks but not its couplings), and stress scene 7 ends at strain 0.36 instead of 0.27 (0.33,
   /// 0.44, 0.31 at 0.3, 3, 10): its stretch comes from the self-collision pass against the
