@@ -110,7 +110,11 @@ TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
   EXPECT_GE(deepest, 0.0) << "a vertex went into the pusher sphere";
   monitor.expectPasses("stacked_sheets_through_ring", kCottonStrainLimit,
                        {{StressMonitor::Condition::Strain,
-                         "measured 0.27 with the Gauss-Seidel PCG (0.26 with block Jacobi; edges the "
+                         "measured 0.615 with the contact-aware solver default (171 edge-substeps "
+                         "left over; the layers' self-contacts fall below the jam density after "
+                         "frame 57 while colliders squeeze them, so most solves are loose); "
+                         "with every solve at the residual 1e-3 (the former default) "
+                         "0.27 with the Gauss-Seidel PCG (0.26 with block Jacobi; edges the "
                          "limiter left over: 54 edge-substeps in 150 frames), with the limiter also run after the collisions (3.69 before, "
                          "when this scene ran the default material and the limiter was off): the "
                          "sheets are dragged through a ring 0.36 m across by a kinematic sphere; "
