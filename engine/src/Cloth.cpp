@@ -698,14 +698,7 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
     m_heldSeparations.clear();
     if (selfCollision) {
       for (const SeparationHold& hold : m_selfCollision->separationHolds()) {
-        Real lightest = 0, heaviest = std::numeric_limits<Real>::infinity();
-        for (int k = 0; k < 4; ++k) {
-          const Real w = m_inverseMasses[hold.vertices[k]];
-          if (w == 0 || hold.weights[k] == 0) continue;
-          lightest = std::max(lightest, w);
-          heaviest = std::min(heaviest, w);
-        }
-        if (lightest > kHeldContactMassRatio * heaviest) m_heldSeparations.push_back(hold);
+        if (spansHeldMassRatio(hold, m_inverseMasses)) m_heldSeparations.push_back(hold);
       }
     }
     const StrainLimitReport limited =

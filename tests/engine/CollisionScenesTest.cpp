@@ -13,8 +13,10 @@ namespace weft {
 namespace {
 
 using test::closestApproach;
+using test::cornerDrop;
 using test::horizontalSquare;
 using test::IntersectionCounter;
+using test::napkinFoldTargets;
 
 constexpr Real kFrame = 1.0 / 60.0;
 constexpr Index kSide = 15;  // vertices per side
@@ -34,13 +36,7 @@ TEST(CollisionScenes, ANapkinFoldedInHalfOnTheFloor) {
   for (int frame = 0; frame < kFoldFrames + kHoldFrames; ++frame) {
     // A half turn about the x axis through the middle, 2 cm above the floor at its end.
     const Real s = std::min<Real>(1, Real(frame + 1) / kFoldFrames);
-    const Real angle = M_PI * s;
-    std::vector<Vec3> targets = start;
-    for (Vec3& target : targets) {
-      target.z() = 0.5 * kSize * std::cos(angle);
-      target.y() = 0.01 + 0.01 * s + 0.3 * std::sin(angle);
-    }
-    ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
+    ASSERT_TRUE(world.setPinTargets(cloth, napkinFoldTargets(start, s, kSize)).ok());
     world.step(kFrame);
     selfContacts += world.stats().selfContacts;
     ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
@@ -63,15 +59,9 @@ TEST(CollisionScenes, AClothDroppedOnACornerCrumplesOnTheFloor) {
   // Upright (turned a quarter about x), then a diamond (45° about z), so that it lands on one
   // corner from 30 cm: the lower part buckles and the rest falls onto it. (Tilted by 0.05 rad,
   // as first written, the cloth with isometric bending topples flat without touching itself.)
-  ClothSettings settings;
-  const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitX()).toRotationMatrix();
-  const Mat3 onCorner = Eigen::AngleAxis<Real>(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
-  settings.rotation = onCorner * upright;
   const std::shared_ptr<const ClothModel> model = horizontalSquare(kSide, kSize, 0.0);
-  // Lift it so that its lowest vertex starts 30 cm above the floor.
-  Real lowest = 1e9;
-  for (const Vec3& p : model->restPositions()) lowest = std::min(lowest, Vec3(settings.rotation * p).y());
-  settings.translation = Vec3(0, 0.3 - lowest, 0);
+  // Its lowest vertex starts 30 cm above the floor.
+  const ClothSettings settings = cornerDrop(*model, 0.3);
   const ClothId cloth = world.createCloth(model, settings).value();
   IntersectionCounter counter(world, {cloth});
   Index selfContacts = 0;

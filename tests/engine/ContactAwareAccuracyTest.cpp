@@ -16,6 +16,7 @@
 namespace weft {
 namespace {
 
+using test::cornerDrop;
 using test::horizontalSquare;
 
 constexpr Real kFrame = 1.0 / 60.0;
@@ -29,15 +30,9 @@ struct CornerDrop {
   ClothId cloth;
   explicit CornerDrop(const SolverSettings& solver) {
     (void)world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
-    ClothSettings settings;
-    settings.solver = solver;
-    const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitX()).toRotationMatrix();
-    const Mat3 onCorner = Eigen::AngleAxis<Real>(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
-    settings.rotation = onCorner * upright;
     const std::shared_ptr<const ClothModel> model = horizontalSquare(kSide, kSize, 0.0);
-    Real lowest = 1e9;
-    for (const Vec3& p : model->restPositions()) lowest = std::min(lowest, Vec3(settings.rotation * p).y());
-    settings.translation = Vec3(0, 0.3 - lowest, 0);
+    ClothSettings settings = cornerDrop(*model, 0.3);
+    settings.solver = solver;
     cloth = world.createCloth(model, settings).value();
   }
 };

@@ -7,7 +7,11 @@
 #include <weft/collision/SelfIntersectionCounter.h>
 #include <weft/engine/World.h>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
 
 #include <limits>
 #include <memory>
@@ -103,6 +107,32 @@ inline Real closestDistanceBetween(const World& world, ClothId a, ClothId b) {
     }
   }
   return closest;
+}
+
+/// The corner drop of the contact scenes: a square model (horizontalSquare) turned upright (a
+/// quarter turn about x), then a diamond (45° about z), its lowest vertex `lift` above the floor
+/// (y = 0), so that it lands on one corner, buckles, and the rest falls onto it.
+inline ClothSettings cornerDrop(const ClothModel& model, Real lift) {
+  ClothSettings settings;
+  const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitX()).toRotationMatrix();
+  const Mat3 onCorner = Eigen::AngleAxis<Real>(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
+  settings.rotation = onCorner * upright;
+  Real lowest = 1e9;
+  for (const Vec3& p : model.restPositions()) lowest = std::min(lowest, Vec3(settings.rotation * p).y());
+  settings.translation = Vec3(0, lift - lowest, 0);
+  return settings;
+}
+
+/// The napkin fold's pin targets: the row pinned at z = +size/2 (start) carried by the fraction
+/// `s` ∈ [0, 1] of a half turn about the x axis through the middle, ending 2 cm above the floor.
+inline std::vector<Vec3> napkinFoldTargets(const std::vector<Vec3>& start, Real s, Real size) {
+  const Real angle = M_PI * s;
+  std::vector<Vec3> targets = start;
+  for (Vec3& target : targets) {
+    target.z() = 0.5 * size * std::cos(angle);
+    target.y() = 0.01 + 0.01 * s + 0.5 * size * std::sin(angle);
+  }
+  return targets;
 }
 
 }  // namespace weft::test

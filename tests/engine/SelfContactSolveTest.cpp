@@ -15,23 +15,12 @@ namespace weft {
 namespace {
 
 using test::closestApproach;
+using test::cornerDrop;
 using test::horizontalSquare;
 using test::IntersectionCounter;
+using test::napkinFoldTargets;
 
 constexpr Real kFrame = 1.0 / 60.0;
-
-// The corner crumple: a 0.6 m square of 15 × 15 vertices, upright and turned to stand on a
-// corner, its lowest vertex `lift` above the floor.
-ClothSettings cornerDrop(const ClothModel& model, Real lift) {
-  ClothSettings settings;
-  const Mat3 upright = Eigen::AngleAxis<Real>(M_PI / 2, Vec3::UnitX()).toRotationMatrix();
-  const Mat3 onCorner = Eigen::AngleAxis<Real>(M_PI / 4, Vec3::UnitZ()).toRotationMatrix();
-  settings.rotation = onCorner * upright;
-  Real lowest = 1e9;
-  for (const Vec3& p : model.restPositions()) lowest = std::min(lowest, Vec3(settings.rotation * p).y());
-  settings.translation = Vec3(0, lift - lowest, 0);
-  return settings;
-}
 
 TEST(SelfContactSolve, ACrumpledPileSettlesAtATightSolverTolerance) {
   // At cgTolerance 1e-4 (relative residual) the drop from 30.0 and 30.2 cm ends as a pile still
@@ -93,13 +82,7 @@ TEST(SelfContactSolve, ANapkinFoldedByItsPinsStaysUntangledWithPinsRemovedKeptOr
     Index selfContacts = 0;
     for (int frame = 0; frame < kFoldFrames + kHoldFrames; ++frame) {
       const Real s = std::min<Real>(1, Real(frame + 1) / kFoldFrames);
-      const Real angle = M_PI * s;
-      std::vector<Vec3> targets = start;
-      for (Vec3& target : targets) {
-        target.z() = 0.5 * kSize * std::cos(angle);
-        target.y() = 0.01 + 0.01 * s + 0.3 * std::sin(angle);
-      }
-      ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
+      ASSERT_TRUE(world.setPinTargets(cloth, napkinFoldTargets(start, s, kSize)).ok());
       const StepStatus status = world.step(kFrame);
       ASSERT_FALSE(hasFlag(status, StepStatus::RolledBack)) << "frame " << frame;
       selfContacts += world.stats().selfContacts;
