@@ -18,8 +18,9 @@ enum class IntegratorKind {
 const char* integratorName(IntegratorKind kind);
 
 /// Preconditioner of the implicit step's PCG. Both are filtered (pinned and contact directions
-/// stay exactly constrained) and bitwise identical for any thread count; the stopping rule is the
-/// same for both (the block-Jacobi residual norm), so they solve to the same accuracy.
+/// stay exactly constrained) and bitwise identical for any thread count; the stopping test
+/// (SolverSettings::cgStopping) measures the same norm whichever is used, so they solve to the
+/// same accuracy.
 enum class PreconditionerKind {
   /// Inverse 3×3 diagonal block per vertex: one multiply per vertex per iteration, weakest on
   /// stiff cloth (many iterations when off-diagonal coupling dominates the mass).
