@@ -158,6 +158,12 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
            checkPositive("solver.cgTolerance", solver.cgTolerance, ""),
            checkNonNegative("solver.selfContactStiffness", solver.selfContactStiffness,
                             "(times the stretch stiffness; 0 turns it off)"),
+           checkNonNegative("solver.maxPinTravelPerSubstep", solver.maxPinTravelPerSubstep,
+                            "mean edge lengths (0 = no limit)"),
+           checkNonNegative("solver.pinTeleportDistance", solver.pinTeleportDistance,
+                            "cloth sizes (0 = pins never teleport the cloth)"),
+           checkNonNegative("solver.pinTeleportAngle", solver.pinTeleportAngle,
+                            "rad (0 = a turn of the pins never teleports the cloth)"),
        }) {
     if (!problem.empty()) return "cloth settings: " + problem;
   }
@@ -194,21 +200,6 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
   if (solver.cgMaxIterations < 1) return "cloth settings: solver.cgMaxIterations must be at least 1";
   if (solver.newtonIterations < 0) return "cloth settings: solver.newtonIterations must be at least 0";
   if (solver.maxSubsteps < 1) return "cloth settings: solver.maxSubsteps must be at least 1";
-  if (!(solver.maxPinTravelPerSubstep >= 0) || !std::isfinite(solver.maxPinTravelPerSubstep)) {
-    return "cloth settings: solver.maxPinTravelPerSubstep = " +
-           std::to_string(solver.maxPinTravelPerSubstep) +
-           " must be a finite number of edge lengths >= 0 (0 = no limit)";
-  }
-  if (!(solver.pinTeleportDistance >= 0) || !std::isfinite(solver.pinTeleportDistance)) {
-    return "cloth settings: solver.pinTeleportDistance = " +
-           std::to_string(solver.pinTeleportDistance) +
-           " must be a finite number of cloth sizes >= 0 (0 = pins never teleport the cloth)";
-  }
-  if (!(solver.pinTeleportAngle >= 0) || !std::isfinite(solver.pinTeleportAngle)) {
-    return "cloth settings: solver.pinTeleportAngle = " + std::to_string(solver.pinTeleportAngle) +
-           " must be a finite angle in radians >= 0 (0 = a turn of the pins never teleports the "
-           "cloth)";
-  }
   if (!settings.translation.allFinite() || !settings.rotation.allFinite()) {
     return "cloth settings: translation or rotation contains NaN or infinity";
   }
