@@ -29,6 +29,21 @@ Real heldWeight(Real weightA, Real weightB, const Vec3& normalA, const Vec3& nor
   return held > kSmallestHeldWeight * (weightA + weightB) ? held : 0;
 }
 
+// The fraction of a held correction to take (see "A held end's step" in StrainLimiting.h): the
+// correction changes the edge vector `delta` by `change` (the difference of its ends' shifts);
+// the result is the first s in (0, 1] with |delta + s change| = longest, or, when the edge
+// cannot get that short along `change`, the s at which it is shortest. Exactly 1 is kept for a
+// linearised step that does not overshoot, so an edge the step brings to the limit to round-off
+// keeps its full step.
+Real heldStepFraction(const Vec3& delta, const Vec3& change, Real longest) {
+  const Real a = change.squaredNorm(), b = delta.dot(change);
+  if (!(a > 0) || !(b < 0)) return 0;  // the correction would not shorten the edge at all
+  const Real c = delta.squaredNorm() - longest * longest;
+  const Real discriminant = b * b - a * c;
+  const Real fraction = discriminant >= 0 ? (-b - std::sqrt(discriminant)) / a : -b / a;
+  return std::min<Real>(1, fraction);
+}
+
 }  // namespace
 
 StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
@@ -140,6 +155,13 @@ void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasse
       shiftA -= normalA.dot(shiftA) * normalA;
       shiftB = -weightB * impulse;
       shiftB -= normalB.dot(shiftB) * normalB;
+      if (!normalA.isZero() || !normalB.isZero()) {
+        // The held step is linearised and can carry an end past the point where the edge is
+        // shortest (see "A held end's step"): take the part that reaches the limit.
+        const Real fraction = heldStepFraction(delta, shiftB - shiftA, longest);
+        shiftA *= fraction;
+        shiftB *= fraction;
+      }
     } else {
       const Vec3 impulse = ((length - longest) / (weightSum * length)) * delta;
       shiftA = weightA * impulse;
@@ -196,6 +218,19 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
             if (jacobi) {
               m_overLimit[e] = over;
               if (over) m_impulses[e] = ((length - longest) / (weightSum * length)) * delta;
+              const bool held = inContact && (!contactNormals[edge.a].isZero() ||
+                                              !contactNormals[edge.b].isZero());
+              if (over && held) {
+                // The fraction of the held step that does not overshoot, as in the sweep: taken
+                // as if the edge moved alone (the gather gives it a share of at most that).
+                const Vec3& normalA = contactNormals[edge.a];
+                const Vec3& normalB = contactNormals[edge.b];
+                Vec3 shiftA = inverseMasses[edge.a] * m_impulses[e];
+                shiftA -= normalA.dot(shiftA) * normalA;
+                Vec3 shiftB = -inverseMasses[edge.b] * m_impulses[e];
+                shiftB -= normalB.dot(shiftB) * normalB;
+                m_impulses[e] *= heldStepFraction(delta, shiftB - shiftA, longest);
+              }
             }
             if (over) blockOver += length > tolerantFactor * edge.restLength;
           }

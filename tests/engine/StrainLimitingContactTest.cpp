@@ -66,6 +66,37 @@ TEST(StrainLimitingInContact, AnEdgeHeldAlongItselfAtBothEndsIsLeftToTheCollisio
   EXPECT_EQ(x, x0);
 }
 
+// An edge that leans only 3° off its held end's normal: its linearised correction, excess /
+// √(1 − (n·d)²) across the normal, would carry that end 2 m along the floor, 33 times past the
+// point where the edge is shortest (StrainLimiting.h, "A held end's step"), and stretch the end's
+// other edge with it. The step is cut at the shortest point: this edge cannot reach the limit by
+// sliding, so it is left no longer than it was, and the other edge stays within the limit.
+TEST(StrainLimitingInContact, AHeldStepStopsWhereTheEdgeIsShortestInsteadOfOvershooting) {
+  TaskSystem tasks(TaskSystemSettings{1});
+  const std::vector<Edge> edges{makeEdge(0, 1, 1.0), makeEdge(0, 2, 0.1)};
+  StrainLimiter limiter(edges, 3);
+  // Vertex 0 on the floor (held along +y), vertex 1 fixed above it and 6 cm aside (strain 0.2),
+  // vertex 2 free on the floor beside vertex 0, its edge at rest.
+  const std::vector<Real> inverseMasses{1.0, 0.0, 1.0};
+  const Vec3Array normals{Vec3(0, 1, 0), Vec3::Zero(), Vec3(0, 1, 0)};
+  for (StrainLimitOrder order : {StrainLimitOrder::GaussSeidel, StrainLimitOrder::Jacobi}) {
+    Vec3Array x{Vec3(0, 0, 0), Vec3(0.06, 1.2, 0), Vec3(-0.1, 0, 0)};
+    Vec3Array v(3, Vec3::Zero());
+    const Real before = (x[1] - x[0]).norm();
+    const StrainLimitReport report = limiter.applyInContact(
+        {.limit = 0.1, .order = order}, inverseMasses, normals, kStep, x, v, tasks);
+    const bool gaussSeidel = order == StrainLimitOrder::GaussSeidel;
+    // Slid toward the point under vertex 1, not past it, and stayed on the floor.
+    EXPECT_GE(x[0].x(), 0.0) << gaussSeidel;
+    EXPECT_LE(x[0].x(), 0.06 + 1e-9) << gaussSeidel;
+    EXPECT_EQ(x[0].y(), 0.0) << gaussSeidel;
+    EXPECT_LE((x[1] - x[0]).norm(), before) << gaussSeidel;
+    EXPECT_NEAR((x[1] - x[0]).norm(), 1.2, 1e-3) << gaussSeidel;  // about as short as sliding makes it
+    EXPECT_LE((x[2] - x[0]).norm(), 0.1 * (1.1 + 1e-3)) << gaussSeidel;
+    EXPECT_EQ(report.edgesOverLimit, 0u) << gaussSeidel;  // the first edge: not correctable
+  }
+}
+
 // A chain of 40 vertices hanging from a pin, stretched to strain 1: Gauss–Seidel passes each
 // correction on within its sweep, where Jacobi moves each vertex by an average of its edges'
 // corrections from the same positions. (Both need thousands of iterations: a long pinned chain
