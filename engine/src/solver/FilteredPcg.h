@@ -310,7 +310,8 @@ class FilteredPcg {
   MulticolorOrdering m_ordering;        ///< order of A's rows (Gauss–Seidel only)
   std::vector<Mat3> m_lowerBlocks;      ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
   std::vector<Mat3> m_upperBlocks;      ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
-  Vec3Array m_snapshot;                 ///< Δv at the start of the progress window (velocity test)
+  /// The velocity test's last w iterates, slot k mod w holding Δv_k (w · vertex count entries).
+  Vec3Array m_progressRing;
   std::vector<Real> m_stopMass;         ///< kg, m_i of the velocity test (0 on fixed vertices)
   std::vector<Real> m_inverseMass;      ///< 1/kg, 1/m_i of the velocity test (0 on fixed vertices)
   TaskSystem* m_tasks = nullptr;        ///< the current solve's task system, or null (serial)
