@@ -95,7 +95,21 @@ TEST(SelfContactSolve, ANapkinFoldedByItsPinsStaysUntangledWithPinsRemovedKeptOr
     const std::span<const Vec3> x = world.positions(cloth).value();
     EXPECT_LT(x[kSide / 2].z(), -0.2);
     EXPECT_GT(x[kSide / 2].y(), x[(kSide - 1) * kSide + kSide / 2].y() + ClothMaterial{}.thickness);
-    EXPECT_GT(x[(kSide / 4) * kSide + kSide / 2].y(), x[(3 * kSide / 4) * kSide + kSide / 2].y());
+    // Where the carried half lies over the other (the middle column, within half an edge in z), it
+    // is the upper layer. Which rows meet is chaotic: the half may land folded again (an S), so
+    // no row pairing is asserted, only the order of the layers, and that they do overlap.
+    const Real halfEdge = 0.5 * kSize / Real(kSide - 1);
+    int stacked = 0;
+    for (Index top = 1; top < kSide / 2; ++top) {
+      const Vec3& upper = x[top * kSide + kSide / 2];
+      for (Index bottom = kSide / 2 + 1; bottom < kSide; ++bottom) {
+        const Vec3& lower = x[bottom * kSide + kSide / 2];
+        if (std::abs(upper.z() - lower.z()) > halfEdge || std::abs(upper.y() - lower.y()) > 0.05) continue;
+        EXPECT_GT(upper.y(), lower.y()) << "row " << top << " under row " << bottom;
+        ++stacked;
+      }
+    }
+    EXPECT_GE(stacked, 2) << "the carried half does not lie on the other";
     EXPECT_LT(world.stats().maxStrain, 0.2);
   }
 }

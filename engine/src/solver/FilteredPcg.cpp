@@ -141,21 +141,37 @@ Real filteredProductRange(Index begin, Index end, const BlockSparseMatrix& A,
   return sum;
 }
 
-/// ‖Δv − snapshot‖²_M over one vertex, then snapshot = Δv (the window's progress, header
-/// "Stopping"); nothing without a snapshot.
+/// The velocity test's progress ring slot an update pass reads and rewrites (header, "Stopping"):
+/// it holds Δv_{k−w} on entry, Δv_k on exit. Null values: no velocity test; measure false: the
+/// slot is only filled (k < w, no iterate w back yet).
+struct ProgressSlot {
+  Vec3* values = nullptr;
+  bool measure = false;
+};
+
+/// m_i‖Δv_k − Δv_{k−w}‖² for one vertex (when measured), then the slot takes Δv_k.
 inline Real progressTerm(const MassWeights& weights, Index vertex, const Vec3& deltaV,
-                         Vec3Array* snapshot) {
-  if (!snapshot) return 0;
-  const Real term = massTerm(weights, vertex, deltaV - (*snapshot)[vertex]);
-  (*snapshot)[vertex] = deltaV;
+                         const ProgressSlot& slot) {
+  if (!slot.values) return 0;
+  const Real term = slot.measure ? massTerm(weights, vertex, deltaV - slot.values[vertex]) : Real(0);
+  slot.values[vertex] = deltaV;
   return term;
 }
 
-/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs, the stopping norm², ‖Δv‖²_M and,
-/// with a snapshot, the window's progress.
+/// The ring slot of the update that makes iterate k (k ≥ 1): slot k mod w, which holds Δv_{k−w}
+/// once k ≥ w (slot 0 holds the start Δv_0). Empty when the velocity test is off.
+ProgressSlot ringSlot(Vec3Array& ring, Index vertexCount, bool velocityTest, int window,
+                      int iteration) {
+  if (!velocityTest) return {};
+  return {ring.data() + std::size_t(iteration % window) * std::size_t(vertexCount),
+          iteration >= window};
+}
+
+/// Δv += α c, r −= α q, s = P̃⁻¹ r over the range; returns Σ rᵀs, the stopping norm², ‖Δv‖²_M and
+/// the progress over the last window (when the slot measures).
 PassSums updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, const Vec3Array& q,
                      const std::vector<Mat3>& inverseDiagonal, const MassWeights& weights,
-                     Vec3Array& deltaV, Vec3Array& r, Vec3Array& s, Vec3Array* snapshot) {
+                     Vec3Array& deltaV, Vec3Array& r, Vec3Array& s, const ProgressSlot& slot) {
   PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
     deltaV[vertex] += alpha * c[vertex];
@@ -164,7 +180,7 @@ PassSums updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, con
     sum.cg += r[vertex].dot(s[vertex]);
     sum.stop += stopTerm(weights, vertex, r[vertex], s[vertex]);
     sum.scale += massTerm(weights, vertex, deltaV[vertex]);
-    sum.progress += progressTerm(weights, vertex, deltaV[vertex], snapshot);
+    sum.progress += progressTerm(weights, vertex, deltaV[vertex], slot);
   }
   return sum;
 }
@@ -249,12 +265,12 @@ Real diagonalRange(Index begin, Index end, const BlockSparseMatrix& A, const Ver
   return sum;
 }
 
-/// Δv += α t, r̂ −= α (t + w), ŝ = D̃ r̂ over the range; returns Σ r̂ᵀŝ, ‖Δv‖²_M and, with a
-/// snapshot, the window's progress.
+/// Δv += α t, r̂ −= α (t + w), ŝ = D̃ r̂ over the range; returns Σ r̂ᵀŝ, ‖Δv‖²_M and the progress
+/// over the last window (when the slot measures).
 PassSums transformedUpdateRange(Index begin, Index end, Real alpha, const BlockSparseMatrix& A,
                                 const VertexFilter& filter, const MassWeights& weights,
                                 const Vec3Array& t, const Vec3Array& w, Vec3Array& deltaV,
-                                Vec3Array& r, Vec3Array& s, Vec3Array* snapshot) {
+                                Vec3Array& r, Vec3Array& s, const ProgressSlot& slot) {
   PassSums sum;
   for (Index vertex = begin; vertex < end; ++vertex) {
     deltaV[vertex] += alpha * t[vertex];
@@ -262,7 +278,7 @@ PassSums transformedUpdateRange(Index begin, Index end, Real alpha, const BlockS
     s[vertex] = filter.filter(vertex, A.block(A.diagonalSlot(vertex)) * r[vertex]);
     sum.cg += r[vertex].dot(s[vertex]);
     sum.scale += massTerm(weights, vertex, deltaV[vertex]);
-    sum.progress += progressTerm(weights, vertex, deltaV[vertex], snapshot);
+    sum.progress += progressTerm(weights, vertex, deltaV[vertex], slot);
   }
   return sum;
 }
@@ -311,7 +327,9 @@ void FilteredPcg::resize(Index vertexCount) {
   m_inverseDiagonal.assign(vertexCount, Mat3::Zero());
   m_inverseMass.assign(vertexCount, 0);
   m_stopMass.assign(vertexCount, 0);
-  m_snapshot.assign(vertexCount, Vec3::Zero());
+  // The velocity test's ring for the default window; a longer window grows it in solve().
+  m_progressRing.assign(std::size_t(PcgSettings{}.progressWindow) * std::size_t(vertexCount),
+                        Vec3::Zero());
   m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
   m_couplingDiagonal.assign(vertexCount, Mat3::Zero());
   m_couplingProduct.assign(vertexCount, Vec3::Zero());
@@ -566,6 +584,14 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   if (velocityTest) {
     stopping.scaleFloor = std::max(settings.velocityFloor, Real(0)) * std::sqrt(movingMass);
     stopping.window = std::clamp(settings.progressWindow, 1, 1 << 20);
+    // Iterate k writes slot k mod w, k ≤ maxIterations: a window beyond the cap needs only
+    // maxIterations + 1 slots (and never measures). Grows (allocates) only for a window longer
+    // than the default one resize() made room for.
+    const std::size_t slots =
+        std::size_t(std::min(stopping.window, std::max(settings.maxIterations, 0) + 1));
+    if (m_progressRing.size() < slots * std::size_t(vertexCount)) {
+      m_progressRing.resize(slots * std::size_t(vertexCount));
+    }
   }
   if (gaussSeidel) {
     iterateGaussSeidel(A, filter, weights, stopping, start, deltaV, report);
@@ -633,16 +659,15 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
   // The velocity test's progress window starts at the initial guess.
   if (stopping.velocityTest) {
     forEachBlock(vertexCount,
-                 [&](Index begin, Index end) { copyRange(begin, end, deltaV, m_snapshot); });
+                 [&](Index begin, Index end) { copyRange(begin, end, deltaV, m_progressRing); });
   }
 
   PassSums sums = start;
   Real previousDelta = sums.cg;
   for (;;) {
-    // The progress of the window that ended with the last update, if one did.
-    const bool windowEnded = stopping.velocityTest && report.iterations > 0 &&
-                             report.iterations % stopping.window == 0;
-    if (stopping.judge(sums.stop, sums.cg, sums.scale, windowEnded ? sums.progress : Real(-1),
+    // The progress over the last window, once w iterations have run (header, "Stopping").
+    const bool windowFull = stopping.velocityTest && report.iterations >= stopping.window;
+    if (stopping.judge(sums.stop, sums.cg, sums.scale, windowFull ? sums.progress : Real(-1),
                        report) ||
         !std::isfinite(report.residualNorm)) {
       break;
@@ -677,12 +702,11 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
     }
     const Real alpha = sums.cg / curvature;
     previousDelta = sums.cg;
-    Vec3Array* snapshot = stopping.velocityTest && (report.iterations + 1) % stopping.window == 0
-                              ? &m_snapshot
-                              : nullptr;
+    const ProgressSlot slot = ringSlot(m_progressRing, vertexCount, stopping.velocityTest,
+                                       stopping.window, report.iterations + 1);
     sums = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
       return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, weights, deltaV, r, s,
-                         snapshot);
+                         slot);
     });
     ++report.iterations;
   }
@@ -708,7 +732,7 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   if (stopping.maxIterations <= 0) return;
   if (stopping.velocityTest) {
     forEachBlock(vertexCount,
-                 [&](Index begin, Index end) { copyRange(begin, end, deltaV, m_snapshot); });
+                 [&](Index begin, Index end) { copyRange(begin, end, deltaV, m_progressRing); });
   }
 
   forwardSweep<false>(filter, c, t, r);  // r̂ = P_L⁻¹ r, in place
@@ -739,7 +763,7 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
     }
     if (report.iterations > 0) {
       // The velocity test's window progress is free (fused into the update); when it meets the
-      // threshold the solve ends without the exact residual's half-SpMV.
+      // threshold, the exact residual (half an SpMV) says whether the residual test agrees.
       const Real estimate =
           startDelta > 0 ? startNorm * std::sqrt(std::max(delta, Real(0)) / startDelta) : Real(0);
       const bool windowMet =
@@ -779,16 +803,15 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
     }
     const Real alpha = delta / curvature;
     previousDelta = delta;
-    Vec3Array* snapshot = stopping.velocityTest && (report.iterations + 1) % stopping.window == 0
-                              ? &m_snapshot
-                              : nullptr;
+    const ProgressSlot slot = ringSlot(m_progressRing, vertexCount, stopping.velocityTest,
+                                       stopping.window, report.iterations + 1);
     const PassSums sums = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
       return transformedUpdateRange(begin, end, alpha, A, filter, weights, t, w, deltaV, r, s,
-                                    snapshot);
+                                    slot);
     });
     delta = sums.cg + addCouplingDiagonal(filter, r, s);
     solutionSquaredNorm = sums.scale;
-    progress = snapshot ? sums.progress : Real(-1);
+    progress = slot.measure ? sums.progress : Real(-1);
     ++report.iterations;
   }
 }
