@@ -53,14 +53,15 @@
 //   modes, which block Jacobi resolves in a few iterations, but an underestimate where CG crawls
 //   (static scenes with 10 s steps). So it ends the solve only while the relative-residual test
 //   below (same tolerance) holds too: the residual sees stiff and slowly converging errors, the
-//   window sees the soft ones the residual is blind to. Fused into the update pass every w-th
-//   iteration (one more vector, m_snapshot). Measured and not adopted (issue 7, branch
-//   verrwindow): the window at every iteration k ≥ w (a ring of the last w iterates). It ends
-//   each solve up to w − 1 iterations sooner (the curtain's quick sweep: 0.89x the CG iterations
-//   at 0.94x the error) but saves nothing on the 10 s curtain (11.6 → 11.7 CG/frame: a warm start
-//   inherits what the last solve left), and it flips two contact tests (one, the sphere drape,
-//   flips with the every-w-th rule too, at window 2 or 5 or at tolerance 3e-2;
-//   bench/results/error-time-curtain.md).
+//   window sees the soft ones the residual is blind to. Measured at every iteration k ≥ w, fused
+//   into the update pass: a ring of the last w iterates (slot k mod w holds Δv_{k−w} until
+//   iteration k reads it and writes Δv_k there), so a solve ends at the first iteration that
+//   meets the test, not at the next multiple of w. Measured (issue 7, branch verrwindow): with the
+//   test only every w-th iteration the curtain's solves piled up at 8 and 12 iterations; checked
+//   at every one they spread from 4 to 22, the quick sweep's defaults take 0.89x the CG
+//   iterations at 0.94x the error (10.40 → 9.27 a frame, RMS 0.0205 → 0.0193), and the 10 s
+//   curtain is unchanged (11.6 → 11.7: a warm start inherits what the last solve left). One more
+//   read and write of a vector per iteration; w vectors of memory.
 //   Measured on stress scene 2 with block Jacobi (issue 7): the bound alone hits the 200-iteration
 //   cap in 87 of 90 frames at ×10⁴ (tolerance 1e-2); the energy norm ‖e‖_A (bound or
 //   Hestenes–Stiefel, window 4) in 3 and 2 frames at ×10² and ×10⁴ (3e-2); this test in none at
@@ -149,9 +150,8 @@ struct PcgSettings {
   Real velocityFloor = 1e-3;
   /// VelocityError only: iterations per progress window; the velocity change over a window is
   /// the estimate of the error left at its start (header, "Stopping"). Longer is safer and stops
-  /// later; 4 measured enough on the stress scenes (bench/results/error-time-curtain.md). As the
-  /// default, windows 2 and 5 fail the sphere-drape collider test (3, 6 and 8 pass it), which is
-  /// sensitive to any change of the trajectory (same file, branch verrwindow).
+  /// later; 4 measured enough on the stress scenes (bench/results/error-time-curtain.md; windows 2
+  /// to 7 on the curtain's quick sweep are there too).
   int progressWindow = 4;
   /// Which preconditioner (SolverSettings::preconditioner). The stopping norm does not depend on
   /// it, so the tolerance means the same accuracy whichever is used.
