@@ -22,11 +22,14 @@
 // whatever μ, a_t being the tangential acceleration of the solve. That is why a cloth draped
 // centred over a sphere slides off it (ColliderTest; a point on a 10° incline at μ = 0.3 creeps
 // 3.5 cm in 5 s of 1/240 s steps, FrictionTest). resolve()'s `positionStep` applies friction's
-// velocity change to the position as well (x = x₀ + h v after friction); Cloth does not pass it
-// yet: with it the drape stays on the sphere for 10 s at every stopping tolerance tried, but
-// three contact scenes of the suite change (see the drape branch's report: the corner drop and
-// the crumpled pile stand taller and stir longer, a withdrawing sphere meets the sheet its
-// friction wrapped round it).
+// velocity change to the position as well (x = x₀ + h v after friction). Cloth does not pass it
+// yet. Passed as the substep h, the drape stays on the sphere for 700 frames at cgTolerance
+// 1e-1, 5e-2, 3e-2 and 1e-3 (centre 1.3–1.5 cm from the pole where it landed, < 1 mm of drift
+// from frame 150 on, kinetic energy 5e-5–3e-4 J), but three tests of the suite fail: the
+// withdrawing sphere meets the sheet its friction wrapped round it (gap 10.7 cm against 1 cm,
+// ColliderSlidingTest), the spinning sphere drags the cloth less than the 10 × margin
+// (ColliderTest), the napkin's layers end level (SelfContactSolveTest), and the curtain's hash
+// changes (CG 12.1 instead of 11.6 per frame). Not analysed to the end: open.
 //
 // So a vertex never ends a step inside a collider, whatever the integrator. Rotation of a collider
 // within one step is followed through its pose at both ends of the step (the vertex's start point
