@@ -142,12 +142,20 @@ Vec3 keepOutside(const ColliderFrame& collider, const Vec3& start, const Vec3& e
   return x;
 }
 
+Vec3 coulombFriction(const Vec3& tangential, Real normalImpulse, Real friction) {
+  const Real speed = tangential.norm();
+  if (!(speed > 0)) return tangential;
+  // 1 − μ J / |v_t|, cut at 0: a contact within the cone keeps none of its tangential velocity.
+  const Real kept = std::max<Real>(0, 1 - friction * normalImpulse / speed);
+  return tangential * kept;
+}
+
 ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> colliders,
                                                  const Vec3Array& xStart, const Vec3Array& vStart,
                                                  Real thickness,
                                                  const std::vector<char>& pinned, Vec3Array& x,
                                                  Vec3Array& v, ContactHolds* holds,
-                                                 bool friction) const {
+                                                 bool friction, Real positionStep) const {
   ColliderResponseReport report;
   report.constrainedVertices = Index(m_constrained.size());
   if (colliders.empty()) return report;
@@ -168,18 +176,23 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
       const Vec3 relative = v[i] - contact.velocity;
       const Real normalSpeed = relative.dot(contact.normal);
       Vec3 normalPart = normalSpeed * contact.normal;
-      Vec3 tangential = relative - normalPart;
+      const Vec3 tangential = relative - normalPart;
       if (normalSpeed < 0) normalPart.setZero();
       // Coulomb friction: the normal velocity change over the step (from the solve's constraint
       // and from this pass) bounds how much tangential velocity friction may remove.
       const Real normalChange =
           std::max<Real>(0, (v[i] - vStart[i]).dot(contact.normal)) + std::max<Real>(0, -normalSpeed);
-      const Real tangentialSpeed = tangential.norm();
-      if (friction && tangentialSpeed > 0) {
-        const Real kept = std::max<Real>(0, 1 - collider.friction * normalChange / tangentialSpeed);
-        tangential *= kept;
+      const Vec3 kept = friction ? coulombFriction(tangential, normalChange, collider.friction)
+                                 : tangential;
+      v[i] = contact.velocity + normalPart + kept;
+      if (positionStep > 0 && !touched && kept != tangential) {
+        // x = x₀ + h v with the velocity after friction: a sticking contact stays where it
+        // was. The shift is along the surface, tested against this collider like any motion
+        // (not for a vertex already on another collider, whose corner it could push it into).
+        ColliderFrame still = collider;
+        still.start = collider.end;
+        x[i] = keepOutside(still, x[i], x[i] + positionStep * (kept - tangential), thickness);
       }
-      v[i] = contact.velocity + normalPart + tangential;
       if (holds) {
         // A second surface at an angle to the first leaves the vertex no direction to slide in.
         Vec3& held = holds->normals[i];
