@@ -110,7 +110,8 @@ TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
   EXPECT_GE(deepest, 0.0) << "a vertex went into the pusher sphere";
   monitor.expectPasses("stacked_sheets_through_ring", kCottonStrainLimit,
                        {{StressMonitor::Condition::Strain,
-                         "measured 0.417 (140 edge-substeps the limiter left over), a chaotic "
+                         "measured 0.283 (95 edge-substeps the limiter left over; 0.417 and 140 "
+                         "with the PCG's progress test every 4th iteration only), a chaotic "
                          "draw: the layers shifted by 1e-9 ... 1e-5 m measure 0.29 ... 0.50, and "
                          "with every solve at the residual 1e-3 (before the held-step fix) 0.27 "
                          "... 0.66, so the solve's accuracy is not the cause: every substep from "
@@ -131,7 +132,8 @@ TEST(StressContact, ThreeStackedSheetsPushedThroughARing) {
                          "limiter (0.26 ... 0.50; 0.18 ... 0.48 with the crease), holding self-"
                          "contacts along the pass's direction (0.81), collider contacts counted in"
                          " the jam measure (0.344 before the held-step fix: it changes one substep"
-                         " here)"}});
+                         " here). Not friction: with every friction coefficient 0 it measures "
+                         "0.41 (3.25 at 16 x 16)"}});
 }
 
 TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) {

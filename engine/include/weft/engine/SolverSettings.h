@@ -138,9 +138,10 @@ struct SolverSettings {
   /// Relative accuracy at which each implicit solve's PCG stops, in the sense of cgStopping (hard
   /// substeps are tightened to tightCgTolerance). The default, the velocity error at 1e-1, is the
   /// contact-aware default of issue 7 (bench/results/error-time-curtain.md, "contact-aware
-  /// accuracy"): on the curtain's quick sweep at h = 1/60 s it takes 10.1 CG iterations per frame
-  /// for RMS error 0.0194, against 24.5 and 0.0217 for the residual at 1e-3, within ~4 % (model
-  /// time) of the front, whose nearest point is the residual at 5e-2 (9.0, 0.0175; that one fails
+  /// accuracy"): on the curtain's quick sweep at h = 1/60 s it takes 9.3 CG iterations per frame
+  /// for RMS error 0.0193 (the window test checked at every iteration, FilteredPcg.h), against
+  /// 24.5 and 0.0217 for the residual at 1e-3, within ~4 % (idle wall clock, fastest of 3) of the
+  /// front, whose nearest point is the residual at 5e-2 (9.0, 0.0175; that one fails
   /// 10 tests, among them two layers falling through a sphere, and the residual test at any loose
   /// tolerance loses the swing of a ×10⁴-stiff sheet: it weighs an error in a slow, soft mode by
   /// ~√(m/(m + h²k)), stress scenes 2 and 7). The curtain's error hardly moves with the tolerance
