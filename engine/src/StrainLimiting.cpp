@@ -6,6 +6,8 @@
 #include <cassert>
 #include <cmath>
 #include <limits>
+#include <tuple>
+#include <utility>
 
 namespace weft {
 namespace {
@@ -42,6 +44,18 @@ Real heldStepFraction(const Vec3& delta, const Vec3& change, Real longest) {
   const Real discriminant = b * b - a * c;
   const Real fraction = discriminant >= 0 ? (-b - std::sqrt(discriminant)) / a : -b / a;
   return std::min<Real>(1, fraction);
+}
+
+// The shifts of an edge's ends for a correction `impulse` (from a to b's side: a moves by
+// weightA · impulse, b by −weightB · impulse), each held end kept on its surface (its shift
+// without the part along its contact normal; a zero normal holds nothing).
+std::pair<Vec3, Vec3> heldShifts(Real weightA, Real weightB, const Vec3& impulse,
+                                 const Vec3& normalA, const Vec3& normalB) {
+  Vec3 shiftA = weightA * impulse;
+  shiftA -= normalA.dot(shiftA) * normalA;
+  Vec3 shiftB = -weightB * impulse;
+  shiftB -= normalB.dot(shiftB) * normalB;
+  return {shiftA, shiftB};
 }
 
 }  // namespace
@@ -151,10 +165,7 @@ void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasse
       const Real held = heldWeight(weightA, weightB, normalA, normalB, direction);
       if (held == 0) continue;
       const Vec3 impulse = ((length - longest) / held) * direction;
-      shiftA = weightA * impulse;
-      shiftA -= normalA.dot(shiftA) * normalA;
-      shiftB = -weightB * impulse;
-      shiftB -= normalB.dot(shiftB) * normalB;
+      std::tie(shiftA, shiftB) = heldShifts(weightA, weightB, impulse, normalA, normalB);
       if (!normalA.isZero() || !normalB.isZero()) {
         // The held step is linearised and can carry an end past the point where the edge is
         // shortest (see "A held end's step"): take the part that reaches the limit.
@@ -223,12 +234,9 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
               if (over && held) {
                 // The fraction of the held step that does not overshoot, as in the sweep: taken
                 // as if the edge moved alone (the gather gives it a share of at most that).
-                const Vec3& normalA = contactNormals[edge.a];
-                const Vec3& normalB = contactNormals[edge.b];
-                Vec3 shiftA = inverseMasses[edge.a] * m_impulses[e];
-                shiftA -= normalA.dot(shiftA) * normalA;
-                Vec3 shiftB = -inverseMasses[edge.b] * m_impulses[e];
-                shiftB -= normalB.dot(shiftB) * normalB;
+                const auto [shiftA, shiftB] =
+                    heldShifts(inverseMasses[edge.a], inverseMasses[edge.b], m_impulses[e],
+                               contactNormals[edge.a], contactNormals[edge.b]);
                 m_impulses[e] *= heldStepFraction(delta, shiftB - shiftA, longest);
               }
             }
