@@ -128,6 +128,18 @@ std::string checkStrainLimit(Real value) {
   return text.str();
 }
 
+// A level at or above which a substep is hard (SolverSettings::tightPinTravel,
+// tightSelfContactDensity): any positive value, +infinity included (never hard); 0, negatives and
+// NaN are mistakes.
+std::string checkHardSubstepThreshold(const char* field, Real value, const char* unit,
+                                      const char* infinityMeans) {
+  if (value > 0) return {};
+  std::ostringstream text;
+  text << field << " = " << value << " (" << unit << "): must be greater than 0 (infinity = "
+       << infinityMeans << "; tightCgTolerance = 0 turns the tightening off)";
+  return text.str();
+}
+
 std::string validate(const ClothModel* model, const ClothSettings& settings) {
   if (!model) return "ClothModel is null: build one with ClothModel::grid() or fromMesh()";
   const ClothMaterial& m = settings.material;
@@ -164,6 +176,12 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
                             "cloth sizes (0 = pins never teleport the cloth)"),
            checkNonNegative("solver.pinTeleportAngle", solver.pinTeleportAngle,
                             "rad (0 = a turn of the pins never teleports the cloth)"),
+           checkHardSubstepThreshold("solver.tightPinTravel", solver.tightPinTravel,
+                                     "mean edge lengths per substep",
+                                     "pins never make a substep hard"),
+           checkHardSubstepThreshold("solver.tightSelfContactDensity",
+                                     solver.tightSelfContactDensity, "self-contacts per vertex",
+                                     "self-contact never makes a substep hard"),
        }) {
     if (!problem.empty()) return "cloth settings: " + problem;
   }
@@ -181,20 +199,6 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
     text << "cloth settings: solver.tightCgTolerance = " << solver.tightCgTolerance
          << " (relative residual): must be at least 0 and below 1 (0 = hard substeps are not "
             "tightened)";
-    return text.str();
-  }
-  if (!(solver.tightPinTravel > 0)) {
-    std::ostringstream text;
-    text << "cloth settings: solver.tightPinTravel = " << solver.tightPinTravel
-         << " (mean edge lengths per substep): must be greater than 0 (infinity = pins never "
-            "make a substep hard; tightCgTolerance = 0 turns the tightening off)";
-    return text.str();
-  }
-  if (!(solver.tightSelfContactDensity > 0)) {
-    std::ostringstream text;
-    text << "cloth settings: solver.tightSelfContactDensity = " << solver.tightSelfContactDensity
-         << " (self-contacts per vertex): must be greater than 0 (infinity = self-contact never "
-            "makes a substep hard; tightCgTolerance = 0 turns the tightening off)";
     return text.str();
   }
   if (solver.cgMaxIterations < 1) return "cloth settings: solver.cgMaxIterations must be at least 1";
@@ -424,6 +428,14 @@ Index Cloth::plannedSubsteps(Real frameDt, bool* predictedUnstable,
     *predictedUnstable = true;
   }
   return substeps;
+}
+
+Real Cloth::largestPinTravel() const {
+  Real travel = 0;
+  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
+    travel = std::max(travel, (m_pinEnd[k] - m_pinStart[k]).norm());
+  }
+  return travel;
 }
 
 std::optional<RigidFit> Cloth::teleportMotion() const {
@@ -718,11 +730,8 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
   const RigidMotion* frameStart = m_frameStartMotions.data();
   // A pin yanked far in each substep makes every substep of the frame hard (tightPinTravel);
   // pins move on straight lines through the frame, so each substep has 1/substeps of the travel.
-  Real pinTravel = 0;
-  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
-    pinTravel = std::max(pinTravel, (m_pinEnd[k] - m_pinStart[k]).norm());
-  }
-  const bool yanked = pinTravel >= m_settings.solver.tightPinTravel * m_meanEdgeLength * Real(substeps);
+  const bool yanked =
+      largestPinTravel() >= m_settings.solver.tightPinTravel * m_meanEdgeLength * Real(substeps);
   for (Index substep = 0; substep < substeps; ++substep) {
     IntegratorReport substepReport;
     for (std::size_t k = 0; k < colliders.size(); ++k) {
@@ -838,10 +847,8 @@ HealthFailure Cloth::checkFrameHealth(Real startStrain, Real startKinetic, Real 
   }
   const Real elastic = std::max<Real>(0, m_frameStartPotential - gravityPotential);
   const Real size = m_model->characteristicLength();
-  Real driverSpeed = std::max(kQuietSpeed, m_forces.settings().wind.norm());
-  for (std::size_t k = 0; k < m_pinEnd.size(); ++k) {
-    driverSpeed = std::max(driverSpeed, (m_pinEnd[k] - m_pinStart[k]).norm() / m_frameLength);
-  }
+  Real driverSpeed = std::max({kQuietSpeed, m_forces.settings().wind.norm(),
+                               largestPinTravel() / m_frameLength});
   for (const RigidMotion& motion : m_frameStartMotions) {
     const Real reach = (motion.pose.position - m_savedPositions[0]).norm() + size;
     driverSpeed = std::max(driverSpeed, motion.linearVelocity.norm() +

@@ -111,6 +111,8 @@ class Cloth final : public DynamicSystem {
   /// chosen with gravity's axis); the same fit when the pins turn rigidly by more than
   /// SolverSettings::pinTeleportAngle; else nullopt (no teleport).
   std::optional<RigidFit> teleportMotion() const;
+  /// m, the farthest any pin moves between its frame-start and end targets (0 without pins).
+  Real largestPinTravel() const;
 
   Status setPinTargets(std::span<const Vec3> targets);
   /// N per vertex, added to every evaluation until changed; an empty span removes them.
