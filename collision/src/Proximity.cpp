@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace weft {
 namespace {
@@ -150,6 +151,63 @@ SegmentClosestPoints closestPointsOnSegments(const Vec3& p0, const Vec3& p1, con
   result.pointOnSecond = q0 + u * d2;
   result.distance = (result.pointOnFirst - result.pointOnSecond).norm();
   return result;
+}
+
+SegmentTriangleClosestPoints closestPointsOnSegmentAndTriangle(const Vec3& p0, const Vec3& p1,
+                                                               const Vec3& a, const Vec3& b,
+                                                               const Vec3& c) {
+  SegmentTriangleClosestPoints best;
+  // Does the segment cross the triangle? Its ends on opposite sides of the plane (or one on it),
+  // and the crossing point inside. A degenerate triangle has no plane: its edges answer below.
+  const Vec3 normal = (b - a).cross(c - a);
+  const Real scale = std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
+  if (normal.squaredNorm() > 1e-12 * scale * scale) {
+    const Real side0 = normal.dot(p0 - a), side1 = normal.dot(p1 - a);
+    if ((side0 <= 0 && side1 >= 0) || (side0 >= 0 && side1 <= 0)) {
+      if (side0 != side1) {
+        const Real s = side0 / (side0 - side1);
+        const Vec3 crossing = p0 + s * (p1 - p0);
+        const TriangleClosestPoint onPlane = closestPointOnTriangle(crossing, a, b, c);
+        // The crossing point lies in the plane, so it is inside the triangle exactly when its
+        // closest point is itself (to round-off of the plane's distance).
+        if (onPlane.distance <= 1e-12 * std::sqrt(scale)) {
+          best.segmentParameter = s;
+          best.barycentric = onPlane.barycentric;
+          best.pointOnSegment = crossing;
+          best.pointOnTriangle = onPlane.point;
+          best.distance = 0;
+          return best;
+        }
+      }
+    }
+  }
+  best.distance = std::numeric_limits<Real>::infinity();
+  for (int end = 0; end < 2; ++end) {
+    const Vec3& p = end == 0 ? p0 : p1;
+    const TriangleClosestPoint onTriangle = closestPointOnTriangle(p, a, b, c);
+    if (onTriangle.distance < best.distance) {
+      best.segmentParameter = Real(end);
+      best.barycentric = onTriangle.barycentric;
+      best.pointOnSegment = p;
+      best.pointOnTriangle = onTriangle.point;
+      best.distance = onTriangle.distance;
+    }
+  }
+  const Vec3* corners[3] = {&a, &b, &c};
+  for (int edge = 0; edge < 3; ++edge) {
+    const int from = edge, to = (edge + 1) % 3;
+    const SegmentClosestPoints pair = closestPointsOnSegments(p0, p1, *corners[from], *corners[to]);
+    if (pair.distance < best.distance) {
+      best.segmentParameter = pair.firstParameter;
+      best.barycentric = Vec3::Zero();
+      best.barycentric[from] = 1 - pair.secondParameter;
+      best.barycentric[to] = pair.secondParameter;
+      best.pointOnSegment = pair.pointOnFirst;
+      best.pointOnTriangle = pair.pointOnSecond;
+      best.distance = pair.distance;
+    }
+  }
+  return best;
 }
 
 }  // namespace weft

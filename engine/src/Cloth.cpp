@@ -670,6 +670,25 @@ void Cloth::resolveSelfCollision(Real h, std::span<ColliderFrame> colliders,
   m_stages.bvhNodesSkipped += refits.skippedNodes;
 }
 
+Index Cloth::resolveFaceContacts() {
+  if (!m_settings.faceContacts) return 0;
+  const ColliderFaceReport faces =
+      m_faceContacts.resolve(m_nearColliders, m_model->triangles(), m_stepStartPositions,
+                             m_inverseMasses, m_settings.material.thickness, m_positions,
+                             m_velocities);
+  if (faces.contacts > 0) {
+    // Pushing a face out of one body can move its corners into another (a sheet pressed between
+    // a ring and a pusher): the vertices keep the last word. Without friction, which the first
+    // pass took; with the holds, so that a corner put on a surface is held there.
+    (void)m_colliderResponse.resolve(m_nearColliders, m_stepStartPositions,
+                                     m_stepStartVelocities, m_settings.material.thickness,
+                                     m_pinnedMask, m_positions, m_velocities,
+                                     m_strainLimiter ? &m_contactHolds : nullptr,
+                                     /*friction=*/false);
+  }
+  return faces.contacts;
+}
+
 void Cloth::selectResponseColliders(std::span<const ColliderFrame> colliders) {
   // The response tests the end positions and the segments from the (carried) start points.
   Aabb end = Aabb::empty(), start = Aabb::empty();
@@ -704,6 +723,10 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
         if (spansHeldMassRatio(hold, m_inverseMasses)) m_heldSeparations.push_back(hold);
       }
     }
+    // Faces on a round body are held one-sided too (ColliderFaceContacts): the limiter slides
+    // them round the body instead of pulling them back into it.
+    const std::span<const SeparationHold> faceHolds = m_faceContacts.holds();
+    m_heldSeparations.insert(m_heldSeparations.end(), faceHolds.begin(), faceHolds.end());
     const StrainLimitReport limited =
         m_strainLimiter->applyInContact(m_strainLimitSettings, m_heldInverseMasses,
                                         m_contactHolds.normals, h, m_positions, m_velocities,
@@ -718,6 +741,7 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
                                        m_stepStartVelocities, m_settings.material.thickness,
                                        m_pinnedMask, m_positions, m_velocities, &m_contactHolds,
                                        /*friction=*/false);
+      (void)resolveFaceContacts();
     }
     if (selfCollision) resolveSelfCollision(h, colliders, report);
   }
@@ -786,7 +810,9 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
           m_settings.material.thickness, m_pinnedMask, m_positions, m_velocities,
           m_strainLimiter ? &m_contactHolds : nullptr);
       report.contacts = contact.contacts;
-      contacts = contact.contacts;
+      contacts = contact.contacts + resolveFaceContacts();
+    } else {
+      m_faceContacts.clear();
     }
     const bool selfCollisionNeeded =
         m_selfCollision && !(m_skipStages && m_foldCulling->cannotTouchItself(

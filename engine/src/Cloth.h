@@ -6,6 +6,7 @@
 #pragma once
 
 #include "ClothForces.h"
+#include "ColliderFaceContacts.h"
 #include "ColliderResponse.h"
 #include "FoldCulling.h"
 #include "RigidFit.h"
@@ -199,6 +200,9 @@ class Cloth final : public DynamicSystem {
   // nothing was over).
   Index limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bool selfCollision,
                              Index edgesOverLimit, ClothFrameReport& report);
+  // Keeps faces out of round colliders (ColliderFaceContacts), after a collider response pass,
+  // and then the vertices out of every collider again; returns the face contacts.
+  Index resolveFaceContacts();
   // The colliders near the substep's start and current positions, into m_nearColliders.
   void selectResponseColliders(std::span<const ColliderFrame> colliders);
   // Colliders whose box comes within the contact distance of `points` go to m_nearColliders;
@@ -263,6 +267,7 @@ class Cloth final : public DynamicSystem {
   bool m_selfContactsLastStep = false;
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
+  ColliderFaceContacts m_faceContacts;             // faces against round bodies, this pass
   ClothStageCounters m_stages;                     // this frame's
   bool m_sleeping = false, m_wakeRequested = false;
   Index m_quietFrames = 0;

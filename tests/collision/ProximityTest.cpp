@@ -138,5 +138,60 @@ TEST(ClosestPointsOnSegments, ParallelDisjointAndZeroLengthSegments) {
   EXPECT_NEAR(r.distance, 2, 1e-15);
 }
 
+TEST(ClosestPointsOnSegmentAndTriangle, MatchesSamplingOnRandomPairs) {
+  std::mt19937 random(3);
+  const int resolution = 60;
+  int crossings = 0;
+  for (int trial = 0; trial < 300; ++trial) {
+    const Vec3 a = randomPoint(random, 1), b = randomPoint(random, 1), c = randomPoint(random, 1);
+    const Vec3 p0 = randomPoint(random, 1.5), p1 = randomPoint(random, 1.5);
+    const SegmentTriangleClosestPoints result = closestPointsOnSegmentAndTriangle(p0, p1, a, b, c);
+    const Vec3& w = result.barycentric;
+    EXPECT_GE(w.minCoeff(), 0);
+    EXPECT_NEAR(w.sum(), 1, 1e-12);
+    EXPECT_GE(result.segmentParameter, 0);
+    EXPECT_LE(result.segmentParameter, 1);
+    EXPECT_LT((result.pointOnTriangle - (w[0] * a + w[1] * b + w[2] * c)).norm(), 1e-12);
+    EXPECT_LT((result.pointOnSegment - (p0 + result.segmentParameter * (p1 - p0))).norm(), 1e-12);
+    EXPECT_NEAR(result.distance, (result.pointOnSegment - result.pointOnTriangle).norm(), 1e-12);
+    // Sampling the segment and the triangle finds nothing closer, and something within the
+    // spacing of the two lattices.
+    Real sampled = std::numeric_limits<Real>::infinity();
+    for (int k = 0; k <= resolution; ++k) {
+      const Vec3 p = p0 + (Real(k) / resolution) * (p1 - p0);
+      sampled = std::min(sampled, sampledTriangleDistance(p, a, b, c, resolution));
+    }
+    const Real longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+    EXPECT_LE(result.distance, sampled + 1e-12) << "trial " << trial;
+    EXPECT_GE(result.distance, sampled - (longest + (p1 - p0).norm()) / resolution) << "trial " << trial;
+    if (result.distance == 0) ++crossings;
+  }
+  EXPECT_GT(crossings, 10);  // the crossing branch was exercised
+}
+
+TEST(ClosestPointsOnSegmentAndTriangle, CrossingPointsAndZeroLengthSegments) {
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  // Straight through the face at (0.25, 0.25): distance 0 there, at the segment's middle.
+  const SegmentTriangleClosestPoints through =
+      closestPointsOnSegmentAndTriangle(Vec3(0.25, 0.25, -1), Vec3(0.25, 0.25, 1), a, b, c);
+  EXPECT_EQ(through.distance, 0);
+  EXPECT_NEAR(through.segmentParameter, 0.5, 1e-15);
+  EXPECT_LT((through.barycentric - Vec3(0.5, 0.25, 0.25)).norm(), 1e-15);
+  // Past the hypotenuse: the closest pair is the segment's point above the edge bc's middle.
+  const SegmentTriangleClosestPoints beside =
+      closestPointsOnSegmentAndTriangle(Vec3(1, 1, -1), Vec3(1, 1, 1), a, b, c);
+  EXPECT_NEAR(beside.distance, std::sqrt(0.5), 1e-15);
+  EXPECT_LT((beside.barycentric - Vec3(0, 0.5, 0.5)).norm(), 1e-15);
+  // A point (a sphere's centre) above the face.
+  const SegmentTriangleClosestPoints point =
+      closestPointsOnSegmentAndTriangle(Vec3(0.2, 0.3, 0.5), Vec3(0.2, 0.3, 0.5), a, b, c);
+  EXPECT_NEAR(point.distance, 0.5, 1e-15);
+  EXPECT_LT((point.pointOnTriangle - Vec3(0.2, 0.3, 0)).norm(), 1e-15);
+  // Parallel to the face above it: every point is at the same height.
+  const SegmentTriangleClosestPoints parallel =
+      closestPointsOnSegmentAndTriangle(Vec3(0.1, 0.1, 0.3), Vec3(0.2, 0.1, 0.3), a, b, c);
+  EXPECT_NEAR(parallel.distance, 0.3, 1e-15);
+}
+
 }  // namespace
 }  // namespace weft

@@ -1,4 +1,4 @@
-// Closest-point kernels: point–triangle and segment–segment (edge–edge).
+// Closest-point kernels: point–triangle, segment–segment (edge–edge) and segment–triangle.
 //
 // Design note
 // -----------
@@ -18,6 +18,12 @@
 // closest pair; the middle of the overlap of their projections is chosen, so the answer is
 // symmetric and stable under tiny rotations instead of jumping between the two ends. Zero-length
 // segments are points.
+//
+// Segment–triangle (a capsule's core against a cloth triangle, ColliderFaceContacts): a segment
+// that crosses the closed triangle is at distance 0 there; otherwise the closest pair has a
+// point on the boundary of one of the two, so it is the nearest of the segment's two ends
+// against the triangle and the segment against the triangle's three edges (five queries of the
+// kernels above). Ties go to the first found in that order, so the answer is deterministic.
 #pragma once
 
 #include <weft/Math.h>
@@ -49,5 +55,19 @@ struct SegmentClosestPoints {
 /// segments (see the design note for which pair is returned when it is not unique).
 SegmentClosestPoints closestPointsOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0,
                                              const Vec3& q1);
+
+/// The closest points of a segment and a triangle.
+struct SegmentTriangleClosestPoints {
+  Real segmentParameter = 0;  ///< s in [0, 1]: pointOnSegment = (1 − s)·p0 + s·p1
+  Vec3 barycentric;           ///< weights of the triangle's corners a, b, c, each in [0, 1]
+  Vec3 pointOnSegment;        ///< m
+  Vec3 pointOnTriangle;       ///< m
+  Real distance = 0;          ///< m, 0 when the segment crosses the triangle
+};
+
+/// Closest points of segment (p0, p1) and triangle (a, b, c). A zero-length segment is a point.
+SegmentTriangleClosestPoints closestPointsOnSegmentAndTriangle(const Vec3& p0, const Vec3& p1,
+                                                               const Vec3& a, const Vec3& b,
+                                                               const Vec3& c);
 
 }  // namespace weft

@@ -1,0 +1,193 @@
+// Cloth faces against round colliders (ColliderFaceContacts): a face with a sphere between its
+// vertices is pushed out along the contact normal by exactly the depth, pins stay, the face's
+// approach velocity goes; a face that crossed the core within the step goes back to the side it
+// came from; and a sheet dropped on a rod thinner than its triangles hangs on it, where with
+// vertex contacts alone the rod passes between the vertices and the sheet falls through.
+#include "ColliderFaceContacts.h"
+#include "ContactTestSupport.h"
+
+#include <weft/collision/Proximity.h>
+#include <weft/engine/FabricPresets.h>
+#include <weft/engine/World.h>
+
+#include <gtest/gtest.h>
+
+#include <array>
+
+namespace weft {
+namespace {
+
+using test::horizontalSquare;
+
+// One horizontal triangle, 0.3 m on its legs, at height `height`, its centroid over the origin.
+std::array<TriangleRest, 1> oneTriangle(Vec3Array& x, Real height) {
+  x = {Vec3(-0.1, height, -0.1), Vec3(0.2, height, -0.1), Vec3(-0.1, height, 0.2)};
+  TriangleRest triangle;
+  triangle.vertices = {0, 1, 2};
+  return {triangle};
+}
+
+// Distance from the sphere's centre (the origin) to the triangle, minus nothing: the face's gap
+// to the core.
+Real coreDistance(const Vec3Array& x) {
+  return closestPointOnTriangle(Vec3::Zero(), x[0], x[1], x[2]).distance;
+}
+
+TEST(ColliderFaceContacts, PushesAFaceOutOfASphereBetweenItsVertices) {
+  // A 5 cm ball under the middle of the face, 2 cm into it; every vertex is far outside it.
+  Shape ball = Sphere::create(0.05).value();
+  const ColliderFrame collider{&ball, RigidMotion{}, RigidMotion{}, 0.3};
+  Vec3Array x, v(3, Vec3(0, -1, 0));
+  const auto triangles = oneTriangle(x, 0.03);
+  const Vec3Array xStart = {x[0] + Vec3(0, 0.1, 0), x[1] + Vec3(0, 0.1, 0), x[2] + Vec3(0, 0.1, 0)};
+  const std::vector<Real> inverseMasses{1, 1, 1};
+  const Real allowance = 0.003;
+  ColliderFaceContacts faces;
+  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
+                                                  triangles, xStart, inverseMasses, allowance, x, v);
+  EXPECT_EQ(report.contacts, 1);
+  // Out to the radius less the allowance, straight up (the face is level over the centre).
+  EXPECT_NEAR(coreDistance(x), 0.05 - allowance, 1e-12);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(x[k].y(), x[0].y(), 1e-12) << "vertex " << k;
+  // No velocity into the ball is left; nothing was added along the face.
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(v[k].y(), 0, 1e-12) << "vertex " << k;
+    EXPECT_NEAR(v[k].x(), 0, 1e-12);
+    EXPECT_NEAR(v[k].z(), 0, 1e-12);
+  }
+  // The limiter's hold keeps the same face point at the same height.
+  ASSERT_EQ(faces.holds().size(), 1u);
+  const SeparationHold& hold = faces.holds()[0];
+  const Vec3 point = hold.weights[0] * x[hold.vertices[0]] + hold.weights[1] * x[hold.vertices[1]] +
+                     hold.weights[2] * x[hold.vertices[2]];
+  EXPECT_NEAR(hold.normal.dot(point), hold.separation, 1e-12);
+  EXPECT_GT(hold.normal.y(), 0.999);
+}
+
+TEST(ColliderFaceContacts, PinnedCornersStayAndTheOthersTakeTheCorrection) {
+  Shape ball = Sphere::create(0.05).value();
+  const ColliderFrame collider{&ball, RigidMotion{}, RigidMotion{}, 0.3};
+  Vec3Array x, v(3, Vec3::Zero());
+  const auto triangles = oneTriangle(x, 0.03);
+  const Vec3Array xStart = x;
+  const Vec3 pinned = x[0];
+  const std::vector<Real> inverseMasses{0, 1, 1};
+  ColliderFaceContacts faces;
+  (void)faces.resolve(std::span<const ColliderFrame>(&collider, 1), triangles, xStart,
+                      inverseMasses, 0.0, x, v);
+  EXPECT_EQ(x[0], pinned);
+  EXPECT_NEAR(coreDistance(x), 0.05, 1e-6);  // swept a few times: the tilted face settles
+  // All three pinned: nothing can move, nothing is done.
+  Vec3Array still;
+  const auto again = oneTriangle(still, 0.03);
+  const Vec3Array before = still;
+  const std::vector<Real> allPinned{0, 0, 0};
+  const ColliderFaceReport none = faces.resolve(std::span<const ColliderFrame>(&collider, 1), again,
+                                                before, allPinned, 0.0, still, v);
+  EXPECT_EQ(none.contacts, 0);
+  EXPECT_EQ(still, before);
+}
+
+TEST(ColliderFaceContacts, AFaceThatCrossedTheCoreGoesBackToTheSideItCameFrom) {
+  // The face started 1 cm above the centre of a 5 cm ball and ended 1 cm below it (its vertices
+  // are outside the ball throughout): its own normal at the end points down, through the ball.
+  Shape ball = Sphere::create(0.05).value();
+  const ColliderFrame collider{&ball, RigidMotion{}, RigidMotion{}, 0.3};
+  Vec3Array x, v(3, Vec3(0, -1.2, 0)), xStart;
+  (void)oneTriangle(xStart, 0.01);
+  const auto triangles = oneTriangle(x, -0.01);
+  const std::vector<Real> inverseMasses{1, 1, 1};
+  ColliderFaceContacts faces;
+  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
+                                                  triangles, xStart, inverseMasses, 0.0, x, v);
+  EXPECT_EQ(report.contacts, 1);
+  EXPECT_NEAR(x[0].y(), 0.05, 1e-12);  // above the ball, where it came from
+  EXPECT_NEAR(v[0].y(), 0, 1e-12);
+}
+
+TEST(ColliderFaceContacts, ACapsuleMovingThroughAFaceIsFollowedInItsFrame) {
+  // A rod (capsule along x) rising 3 cm in the step into a face 2 cm above its axis; the face
+  // is pushed up with the rod, to the radius, and takes the rod's upward speed.
+  RigidMotion start;
+  start.pose.rotation = Quat::FromTwoVectors(Vec3::UnitY(), Vec3::UnitX());
+  start.linearVelocity = Vec3(0, 1.8, 0);
+  RigidMotion end = start;
+  end.pose.position = Vec3(0, 0.03, 0);
+  Shape rod = Capsule::create(0.02, 0.5, end).value();
+  const ColliderFrame collider{&rod, start, end, 0.3};
+  Vec3Array x, v(3, Vec3::Zero());
+  const auto triangles = oneTriangle(x, 0.02);
+  const Vec3Array xStart = x;
+  const std::vector<Real> inverseMasses{1, 1, 1};
+  ColliderFaceContacts faces;
+  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
+                                                  triangles, xStart, inverseMasses, 0.0, x, v);
+  EXPECT_EQ(report.contacts, 1);
+  // On the rod's surface, on the side the face came from (above its axis), and carried up: the
+  // face point of the last contact leaves with the rod (the corners' speeds differ; the face
+  // tilted as it was pushed).
+  const SegmentTriangleClosestPoints gap =
+      closestPointsOnSegmentAndTriangle(Vec3(-0.5, 0.03, 0), Vec3(0.5, 0.03, 0), x[0], x[1], x[2]);
+  EXPECT_NEAR(gap.distance, 0.02, 1e-9);
+  for (int k = 0; k < 3; ++k) EXPECT_GT(x[k].y(), 0.03) << "vertex " << k;
+  for (int k = 0; k < 3; ++k) EXPECT_GE(v[k].y(), 0) << "vertex " << k;
+  EXPECT_GT(v[0].y() + v[1].y() + v[2].y(), 1.8);
+}
+
+// A 0.5 m cotton square (11 × 11 vertices, 5 cm edges) dropped from 10 cm onto a horizontal rod
+// of 2 cm radius under its middle, a little off its centre line. Returns the lowest height of
+// the sheet's middle column after `frames` frames and the deepest any face went into the rod.
+struct RodDrop {
+  Real middleLowest = 0;   // m
+  Real deepestFace = 0;    // m into the rod (negative: outside)
+  Real maxStrain = 0;
+};
+RodDrop dropOnRod(bool faceContacts, int frames) {
+  const Index n = 11;
+  auto model = horizontalSquare(n, 0.5, 0.5);
+  World world;
+  ClothSettings settings;
+  settings.material = cottonFabric();
+  settings.faceContacts = faceContacts;
+  const ClothId cloth = world.createCloth(model, settings).value();
+  RigidMotion pose;
+  pose.pose.position = Vec3(0.013, 0.38, 0);
+  pose.pose.rotation = Quat::FromTwoVectors(Vec3::UnitY(), Vec3::UnitZ());
+  constexpr Real kRadius = 0.02;
+  EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
+  RodDrop result;
+  for (int frame = 0; frame < frames; ++frame) {
+    EXPECT_EQ(world.step(1.0 / 60), StepStatus::Ok);
+    result.maxStrain = std::max(result.maxStrain, world.stats().maxStrain);
+    const std::span<const Vec3> x = world.positions(cloth).value();
+    for (const TriangleRest& t : model->triangles()) {
+      const Real gap = closestPointsOnSegmentAndTriangle(Vec3(0.013, 0.38, -0.5),
+                                                         Vec3(0.013, 0.38, 0.5), x[t.vertices[0]],
+                                                         x[t.vertices[1]], x[t.vertices[2]])
+                           .distance;
+      result.deepestFace = std::max(result.deepestFace, kRadius - gap);
+    }
+  }
+  const std::span<const Vec3> x = world.positions(cloth).value();
+  result.middleLowest = std::numeric_limits<Real>::infinity();
+  for (Index row = 0; row < n; ++row) result.middleLowest = std::min(result.middleLowest, x[row * n + n / 2].y());
+  return result;
+}
+
+TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
+  const RodDrop faces = dropOnRod(true, 40);
+  // On the rod: the middle column is at the rod's top (0.40 m, plus the thickness), not below it.
+  EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the rod";
+  // No face went more than the allowance (the cloth's 3 mm thickness) into the rod.
+  EXPECT_LT(faces.deepestFace, 0.003 + 1e-6);
+  EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
+  // With vertex contacts alone the rod passes between the vertices of the middle column (1.3 cm
+  // from the rod's axis, inside it): every vertex stays outside, the faces do not, and the
+  // sheet falls through.
+  const RodDrop vertices = dropOnRod(false, 40);
+  EXPECT_LT(vertices.middleLowest, 0.2) << "the rod no longer passes through the faces";
+  EXPECT_GT(vertices.deepestFace, 0.01);
+}
+
+}  // namespace
+}  // namespace weft
