@@ -529,7 +529,8 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
   if (!reader.expectObject(object, path, "a cloth")) return std::nullopt;
   reader.checkKeys(object, path,
                    {"name", "grid", "mesh", "translation", "rotation", "forceModel", "material",
-                    "springs", "solver", "selfCollision", "initialPleats", "pins"});
+                    "springs", "solver", "selfCollision", "faceContacts", "initialPleats",
+                    "pins"});
   ClothDescription cloth;
   cloth.name = "cloth " + std::to_string(index);
   reader.readString(object, path, "name", cloth.name);
@@ -585,6 +586,7 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
   if (const Json* springs = Reader::member(object, "springs")) readSprings(reader, *springs, child(path, "springs"), settings.springs);
   if (const Json* solver = Reader::member(object, "solver")) readSolver(reader, *solver, child(path, "solver"), settings.solver);
   reader.readBool(object, path, "selfCollision", settings.selfCollision);
+  reader.readBool(object, path, "faceContacts", settings.faceContacts);
 
   if (const Json* pleats = Reader::member(object, "initialPleats")) {
     const std::string here = child(path, "initialPleats");

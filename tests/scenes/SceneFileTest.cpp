@@ -26,7 +26,8 @@ TEST(SceneFile, EveryShippedSceneLoadsBuildsAndSteps) {
   std::sort(names.begin(), names.end());
   // The curtain, the shared scenes of the collision issue, and the banner (attachments, wind).
   EXPECT_EQ(names, (std::vector<std::string>{"banner", "curtain", "floor-fold", "projectile",
-                                             "rotating-sphere", "sphere-drop", "two-layers"}));
+                                             "rod-hang", "rotating-sphere", "sphere-drop",
+                                             "two-layers"}));
   for (const std::string& name : names) {
     SCOPED_TRACE(name);
     Result<SceneDescription> scene = loadSceneFile(kSceneDir + "/" + name + ".json");
@@ -42,6 +43,17 @@ TEST(SceneFile, EveryShippedSceneLoadsBuildsAndSteps) {
   }
 }
 
+TEST(SceneFile, FaceContactsCanBeTurnedOffPerCloth) {
+  Result<SceneDescription> scene =
+      loadSceneText(R"({"version": 1, "cloths": [{"grid": {}, "faceContacts": false}]})");
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  EXPECT_FALSE(scene->cloths[0].settings.faceContacts);
+  Result<SceneDescription> wrong =
+      loadSceneText(R"({"version": 1, "cloths": [{"grid": {}, "faceContacts": "no"}]})");
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_THAT(wrong.error().message, HasSubstr("/cloths/0/faceContacts"));
+}
+
 TEST(SceneFile, DefaultsAreTheDocumentedOnes) {
   Result<SceneDescription> scene = loadSceneText(R"({"version": 1, "cloths": [{"grid": {}}]})");
   ASSERT_TRUE(scene.ok()) << scene.error().message;
@@ -54,6 +66,7 @@ TEST(SceneFile, DefaultsAreTheDocumentedOnes) {
   EXPECT_EQ(cloth.settings.material.arealDensity, ClothMaterial{}.arealDensity);
   EXPECT_EQ(cloth.settings.solver.integrator, IntegratorKind::ImplicitEuler);
   EXPECT_TRUE(cloth.settings.selfCollision);
+  EXPECT_TRUE(cloth.settings.faceContacts);
   EXPECT_TRUE(cloth.settings.pinnedVertices.empty());
   EXPECT_TRUE(scene->colliders.empty());
 }
