@@ -1,9 +1,11 @@
 #include "ColliderFaceContacts.h"
 
 #include <weft/collision/Proximity.h>
+#include <weft/collision/Shape.h>
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
+#include <limits>
 #include <variant>
 
 namespace weft {
@@ -13,25 +15,125 @@ namespace {
 // neighbouring face's correction undid. Faces rarely share a contact with more than two or three
 // neighbours, so the sweeps converge fast; what is left is within the vertices' thickness.
 constexpr int kMaxSweeps = 4;
-// A sweep that moved no face point farther than this fraction of the body's radius ends the
-// loop: round-off, not contact.
-constexpr Real kSettledFraction = 1e-6;
+// m: a sweep that moved no face point farther than this ends the loop (round-off, not contact).
+constexpr Real kSettledDepth = 1e-9;
 
-// The core of a round body in its own frame (the sphere's centre is a segment of length 0) and
-// its radius; false for other shapes.
-bool roundCore(const Shape& shape, Vec3& coreStart, Vec3& coreEnd, Real& radius) {
+// The cores of a body in its own frame that faces are kept away from (see the design note): a
+// sphere's centre (a segment of length 0) and a capsule's segment, each `radius` − allowance; a
+// box's twelve edges, half the allowance (a face need not keep the thickness from an edge that
+// pokes into it between its vertices, only stay on its side). Appends to `cores`.
+void appendCores(const Shape& shape, Real allowance, std::vector<FaceCore>& cores) {
   if (const Sphere* sphere = std::get_if<Sphere>(&shape)) {
-    coreStart = coreEnd = Vec3::Zero();
-    radius = sphere->radius();
-    return true;
+    cores.push_back({Vec3::Zero(), Vec3::Zero(), sphere->radius() - allowance});
+  } else if (const Capsule* capsule = std::get_if<Capsule>(&shape)) {
+    const Vec3 half(0, capsule->halfLength(), 0);
+    cores.push_back({-half, half, capsule->radius() - allowance});
+  } else if (const Box* box = std::get_if<Box>(&shape)) {
+    const Vec3& e = box->halfExtents();
+    for (int axis = 0; axis < 3; ++axis) {
+      const int u = (axis + 1) % 3, w = (axis + 2) % 3;
+      for (int corner = 0; corner < 4; ++corner) {
+        Vec3 a = Vec3::Zero();
+        a[u] = (corner & 1) ? e[u] : -e[u];
+        a[w] = (corner & 2) ? e[w] : -e[w];
+        Vec3 b = a;
+        a[axis] = -e[axis];
+        b[axis] = e[axis];
+        cores.push_back({a, b, 0.5 * allowance});
+      }
+    }
   }
-  if (const Capsule* capsule = std::get_if<Capsule>(&shape)) {
-    coreStart = Vec3(0, -capsule->halfLength(), 0);
-    coreEnd = Vec3(0, capsule->halfLength(), 0);
-    radius = capsule->radius();
-    return true;
+}
+
+// A point where a face meets a core, in the body's frame: the face point (barycentric weights of
+// the corners), the unit normal from the core to the face, the core point, and how far the face
+// point must move along the normal to be `reach` from the core (≤ 0: it is).
+struct FacePoint {
+  Vec3 barycentric = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();
+  Vec3 corePoint = Vec3::Zero();
+  Real depth = 0;
+};
+
+// Points closer than this (m) outside the reach still count as touching: they get a limiter hold
+// and their approach velocity removed (a face the sweeps just put at the reach is at -1e-17).
+constexpr Real kTouching = 1e-9;
+
+// The contact points of face (a, b, c) with `core` (body frame), at most three, into `points`;
+// returns how many: those deeper than `minDepth`. `cameFrom`: the core-to-face normal at the step
+// start (zero if unknown).
+//  - Over the face's interior: the part of the core segment above the face (clipped to the
+//    triangle's prism) is a line whose height over the plane is linear, so its two ends are
+//    the deepest points: a box edge or a capsule lying parallel to the face touches it along a
+//    line, which one closest point (the kernel's, on an edge of the face) would push only at one
+//    end, tilting the face round the other.
+//  - Beside the face: the closest points of the segment and the triangle, when they lie on the
+//    face's boundary.
+// The side: the one the face came from when it crossed the core within the step (its own normal
+// then points through the body), else its own.
+int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const Vec3& b,
+               const Vec3& c, Real minDepth, std::array<FacePoint, 3>& points) {
+  int count = 0;
+  const Vec3 segment = core.end - core.start;
+  const Vec3 plane = (b - a).cross(c - a);
+  const Real twiceArea = plane.norm();
+  const Real longest = std::max({(b - a).norm(), (c - b).norm(), (a - c).norm()});
+  if (twiceArea > 1e-6 * longest * longest) {
+    const Vec3 up = plane / twiceArea;
+    // Clip the segment to the prism over the triangle: each edge's inward half-space.
+    Real low = 0, high = 1;
+    const Vec3* corners[3] = {&a, &b, &c};
+    for (int edge = 0; edge < 3 && low <= high; ++edge) {
+      const Vec3& from = *corners[edge];
+      const Vec3& to = *corners[(edge + 1) % 3];
+      const Vec3 inward = up.cross(to - from);  // points into the triangle (counter-clockwise about up)
+      const Real at = inward.dot(core.start - from), rate = inward.dot(segment);
+      if (rate == 0) {
+        if (at < 0) high = -1;  // parallel to this edge and outside
+      } else if (rate > 0) {
+        low = std::max(low, -at / rate);
+      } else {
+        high = std::min(high, -at / rate);
+      }
+    }
+    if (low <= high) {
+      const Real ends[2] = {low, high};
+      const bool line = high > low && segment.squaredNorm() > 0;
+      for (int k = 0; k < (line ? 2 : 1); ++k) {
+        const Vec3 corePoint = core.start + ends[k] * segment;
+        const Real height = up.dot(corePoint - a);  // of the core point over the face's plane
+        Real side = cameFrom.isZero() ? 0 : (cameFrom.dot(up) > 0 ? 1 : -1);
+        if (side == 0) side = height < 0 ? 1 : (height > 0 ? -1 : 0);
+        if (side == 0) continue;  // on the face, with no start to tell the side
+        const Vec3 onPlane = corePoint - height * up;
+        // Barycentric weights from the sub-triangle areas (clamped: the point is in the prism).
+        Vec3 weights((b - onPlane).cross(c - onPlane).dot(up), (c - onPlane).cross(a - onPlane).dot(up),
+                     (a - onPlane).cross(b - onPlane).dot(up));
+        weights = weights.cwiseMax(0);
+        const Real total = weights.sum();
+        if (!(total > 0)) continue;
+        FacePoint& point = points[count];
+        point.barycentric = weights / total;
+        point.normal = side * up;
+        point.corePoint = corePoint;
+        point.depth = core.reach + side * height;  // the face point is −side·height from the core
+        if (point.depth > minDepth) ++count;
+      }
+    }
   }
-  return false;
+  const SegmentTriangleClosestPoints closest =
+      closestPointsOnSegmentAndTriangle(core.start, core.end, a, b, c);
+  if (closest.barycentric.minCoeff() == 0 && closest.distance > 0) {
+    Vec3 normal = (closest.pointOnTriangle - closest.pointOnSegment) / closest.distance;
+    if (!cameFrom.isZero() && normal.dot(cameFrom) < 0) normal = cameFrom;
+    FacePoint& point = points[count];
+    point.barycentric = closest.barycentric;
+    point.normal = normal;
+    point.corePoint = closest.pointOnSegment;
+    point.depth = core.reach - normal.dot(closest.pointOnTriangle - closest.pointOnSegment);
+    if (point.depth > minDepth) ++count;
+  }
+  return count;
 }
 
 }  // namespace
@@ -45,98 +147,142 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
   m_holds.clear();
   m_candidates.clear();
   WEFT_PROFILE_ZONE("face contacts");
+  m_cores.clear();
   for (Index k = 0; k < Index(colliders.size()); ++k) {
-    Vec3 coreStart, coreEnd;
-    Real radius = 0;
-    if (!roundCore(*colliders[k].shape, coreStart, coreEnd, radius)) continue;
+    const Index firstCore = Index(m_cores.size());
+    appendCores(*colliders[k].shape, allowance, m_cores);
+    if (Index(m_cores.size()) == firstCore) continue;  // a plane or a mesh: vertices only
     const Aabb body = bounds(*colliders[k].shape);
+    const Pose& endPose = colliders[k].end.pose;
+    const Pose& startPose = colliders[k].start.pose;
     for (Index t = 0; t < Index(triangles.size()); ++t) {
       const std::array<Index, 3>& corner = triangles[t].vertices;
       if (inverseMasses[corner[0]] == 0 && inverseMasses[corner[1]] == 0 &&
           inverseMasses[corner[2]] == 0) {
         continue;
       }
+      // Start and end: a face may cross a thin body within one step (a sheet falling at 1.4 m/s
+      // moves 2.3 cm a step, past a 2 cm plank).
       Aabb box = Aabb::empty();
-      for (Index i : corner) box.expand(x[i]);
-      if (box.overlaps(body)) m_candidates.push_back({t, k, false, {}, Vec3::Zero()});
+      for (Index i : corner) {
+        box.expand(x[i]);
+        box.expand(xStart[i]);
+      }
+      if (!box.overlaps(body)) continue;
+      // The face's path in the body's frame (start and end), against each core's box: a face
+      // that crossed a box's edge within the step may end beside it.
+      Aabb path = Aabb::empty();
+      std::array<Vec3, 3> startLocal;
+      for (int j = 0; j < 3; ++j) {
+        startLocal[j] = startPose.toLocal(xStart[corner[j]]);
+        path.expand(startLocal[j]);
+        path.expand(endPose.toLocal(x[corner[j]]));
+      }
+      for (Index c = firstCore; c < Index(m_cores.size()); ++c) {
+        const FaceCore& core = m_cores[c];
+        Aabb reach = Aabb::empty();
+        reach.expand(core.start);
+        reach.expand(core.end);
+        reach.inflate(std::max<Real>(core.reach, 0));
+        if (!reach.overlaps(path)) continue;
+        // Which side of the core the face started on (zero: it started on the core).
+        const SegmentTriangleClosestPoints before = closestPointsOnSegmentAndTriangle(
+            core.start, core.end, startLocal[0], startLocal[1], startLocal[2]);
+        Candidate candidate;
+        candidate.triangle = t;
+        candidate.collider = k;
+        candidate.core = c;
+        if (before.distance > 0) {
+          candidate.cameFrom = (before.pointOnTriangle - before.pointOnSegment) / before.distance;
+        }
+        m_candidates.push_back(candidate);
+      }
     }
   }
   if (m_candidates.empty()) return report;
 
+  std::array<FacePoint, 3> points;
+  const auto cornersInBody = [&](const Candidate& candidate, std::array<Vec3, 3>& local) {
+    const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
+    const Pose& endPose = colliders[candidate.collider].end.pose;
+    for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
+  };
   for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
     ++report.sweeps;
     bool moved = false;
     for (Candidate& candidate : m_candidates) {
-      const ColliderFrame& collider = colliders[candidate.collider];
-      Vec3 coreStart, coreEnd;
-      Real radius = 0;
-      (void)roundCore(*collider.shape, coreStart, coreEnd, radius);
-      const Real reach = radius - allowance;  // faces are kept this far from the core
       const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
-      const Pose& endPose = collider.end.pose;
-      const SegmentTriangleClosestPoints now = closestPointsOnSegmentAndTriangle(
-          coreStart, coreEnd, endPose.toLocal(x[corner[0]]), endPose.toLocal(x[corner[1]]),
-          endPose.toLocal(x[corner[2]]));
-      if (!(now.distance < reach)) continue;
-      // The side the face is on: its own normal, unless it reached the core or crossed it within
-      // the step (then the start's normal, where the face came from).
-      const Pose& startPose = collider.start.pose;
-      const SegmentTriangleClosestPoints before = closestPointsOnSegmentAndTriangle(
-          coreStart, coreEnd, startPose.toLocal(xStart[corner[0]]),
-          startPose.toLocal(xStart[corner[1]]), startPose.toLocal(xStart[corner[2]]));
-      Vec3 normal = Vec3::Zero();
-      if (now.distance > 0) normal = (now.pointOnTriangle - now.pointOnSegment) / now.distance;
-      if (before.distance > 0) {
-        const Vec3 cameFrom = (before.pointOnTriangle - before.pointOnSegment) / before.distance;
-        if (now.distance == 0 || normal.dot(cameFrom) < 0) normal = cameFrom;
+      const Pose& endPose = colliders[candidate.collider].end.pose;
+      std::array<Vec3, 3> local;
+      cornersInBody(candidate, local);
+      const int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0],
+                                   local[1], local[2], 0, points);
+      bool pushed = false;
+      for (int p = 0; p < count; ++p) {
+        const FacePoint& point = points[p];
+        if (!(point.depth > 0)) continue;
+        const Vec3& b = point.barycentric;
+        Real weight = 0;
+        for (int j = 0; j < 3; ++j) weight += b[j] * b[j] * inverseMasses[corner[j]];
+        if (!(weight > 0)) continue;
+        const Vec3 worldNormal = endPose.directionToWorld(point.normal);
+        for (int j = 0; j < 3; ++j) {
+          x[corner[j]] += (b[j] * inverseMasses[corner[j]] / weight * point.depth) * worldNormal;
+        }
+        pushed = true;
+        moved = moved || point.depth > kSettledDepth;
+        // The next point of this face sees the face where this push left it.
+        if (p + 1 < count) {
+          cornersInBody(candidate, local);
+          (void)facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                           local[2], -std::numeric_limits<Real>::infinity(), points);
+        }
       }
-      if (normal.isZero()) continue;  // inside the core at both ends: no side to choose
-      const Real depth = reach - normal.dot(now.pointOnTriangle - now.pointOnSegment);
-      if (!(depth > 0)) continue;
-      const Vec3& b = now.barycentric;
-      Real weight = 0;
-      for (int j = 0; j < 3; ++j) weight += b[j] * b[j] * inverseMasses[corner[j]];
-      if (!(weight > 0)) continue;
-      const Vec3 worldNormal = endPose.directionToWorld(normal);
-      const Vec3 corePoint = endPose.toWorld(now.pointOnSegment);
-      for (int j = 0; j < 3; ++j) {
-        x[corner[j]] += (b[j] * inverseMasses[corner[j]] / weight * depth) * worldNormal;
-      }
-      if (sweep == 0) ++report.contacts;
-      moved = moved || depth > kSettledFraction * radius;
-      // One hold per face and body, from its last correction: the limiter keeps the face point
-      // on the surface along this normal.
-      candidate.touched = true;
-      candidate.hold.vertices = {corner[0], corner[1], corner[2], corner[0]};
-      candidate.hold.weights = {b[0], b[1], b[2], 0};
-      candidate.hold.normal = worldNormal;
-      candidate.hold.separation = worldNormal.dot(corePoint) + reach;
-      candidate.barycentric = b;
+      if (pushed && !candidate.pushed) ++report.contacts;
+      candidate.pushed = candidate.pushed || pushed;
     }
     if (!moved) break;
   }
-  // Inelastic, once the positions have settled: each face point keeps no velocity into the body
-  // (relative to the body's surface there). Done per sweep instead, every contact of a face that
-  // several sweeps correct adds its own push and the face leaves faster than the body (a rod
-  // rising at 1.8 m/s into a face sent its corners off at up to 2.5 m/s).
+  // Once the positions have settled: each touching face point is held one-sided in the strain
+  // limiter (it slides the cloth round the body instead of pulling the face back in), and keeps
+  // no velocity into the body (inelastic, relative to the body's surface there). Removed in
+  // every sweep instead, the pushes of the successive contacts of one face added up and the face
+  // left faster than the body (a rod rising at 1.8 m/s into a face sent its corners off at up to
+  // 2.5 m/s).
   for (const Candidate& candidate : m_candidates) {
-    if (!candidate.touched) continue;
-    m_holds.push_back(candidate.hold);
     const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
-    const Vec3& b = candidate.barycentric;
-    Real weight = 0;
-    Vec3 facePoint = Vec3::Zero(), faceVelocity = Vec3::Zero();
-    for (int j = 0; j < 3; ++j) {
-      weight += b[j] * b[j] * inverseMasses[corner[j]];
-      facePoint += b[j] * x[corner[j]];
-      faceVelocity += b[j] * v[corner[j]];
-    }
-    const Vec3& normal = candidate.hold.normal;
-    const Vec3 bodyVelocity = colliders[candidate.collider].end.velocityAt(facePoint);
-    const Real approach = (faceVelocity - bodyVelocity).dot(normal);
-    if (approach < 0) {
+    const RigidMotion& body = colliders[candidate.collider].end;
+    std::array<Vec3, 3> local;
+    cornersInBody(candidate, local);
+    // A face the sweeps pushed keeps the body's pace even where the push carried it past the
+    // reach; the others count where they touch.
+    const Real minDepth = candidate.pushed ? -std::numeric_limits<Real>::infinity() : -kTouching;
+    const int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                                 local[2], minDepth, points);
+    for (int p = 0; p < count; ++p) {
+      const FacePoint& point = points[p];
+      const Vec3& b = point.barycentric;
+      const Vec3 normal = body.pose.directionToWorld(point.normal);
+      const Vec3 corePoint = body.pose.toWorld(point.corePoint);
+      SeparationHold hold;
+      hold.vertices = {corner[0], corner[1], corner[2], corner[0]};
+      hold.weights = {b[0], b[1], b[2], 0};
+      hold.normal = normal;
+      hold.separation = normal.dot(corePoint) + m_cores[candidate.core].reach;
+      m_holds.push_back(hold);
+      Real weight = 0;
+      Vec3 facePoint = Vec3::Zero(), faceVelocity = Vec3::Zero();
       for (int j = 0; j < 3; ++j) {
-        v[corner[j]] -= (b[j] * inverseMasses[corner[j]] / weight * approach) * normal;
+        weight += b[j] * b[j] * inverseMasses[corner[j]];
+        facePoint += b[j] * x[corner[j]];
+        faceVelocity += b[j] * v[corner[j]];
+      }
+      if (!(weight > 0)) continue;
+      const Real approach = (faceVelocity - body.velocityAt(facePoint)).dot(normal);
+      if (approach < 0) {
+        for (int j = 0; j < 3; ++j) {
+          v[corner[j]] -= (b[j] * inverseMasses[corner[j]] / weight * approach) * normal;
+        }
       }
     }
   }

@@ -1,55 +1,64 @@
-// ColliderFaceContacts: keeps the faces of a cloth, not only its vertices, out of round colliders
-// (spheres and capsules).
+// ColliderFaceContacts: keeps the faces of a cloth, not only its vertices, out of spheres,
+// capsules and boxes.
 //
 // Design note
 // -----------
 // Why: ColliderResponse keeps every vertex outside every collider (plus the contact thickness),
 // but a triangle is more than its corners. Where a body is thinner than the cloth's triangles —
-// a capsule of 2 cm radius under edges of 3–5 cm — the body can pass between the vertices
-// through a face or an edge while every vertex stays outside. Once through, the cloth hangs on
-// the body by that edge, stretched between the vertices on either side. Measured: a 0.5 m
-// cotton square of 11 × 11 vertices dropped onto a rod of 2 cm radius fell straight through it
-// (ColliderFaceContactsTest), and in stress scene 7 (three sheets pushed through a ring of
-// capsules) the worst edges ran straight through a capsule of the ring, one end inside the ring
-// and one outside, with a face 2 cm deep (the capsule's core) in 33–44 of the 150 frames.
+// a capsule of 2 cm radius or a 2 cm plank under edges of 3–5 cm — the body passes between the
+// vertices through a face while every vertex stays outside. Measured: a 0.5 m cotton square of
+// 11 × 11 vertices dropped onto a rod of 2 cm radius, or onto a plank 2 cm square in section,
+// fell straight through it (ColliderFaceContactsTest); in stress scene 7 (three sheets pushed
+// through a ring of capsules) the worst edges ran straight through a capsule of the ring, one end
+// inside the ring and one outside, with a face at the capsule's core in 33–44 of the 150 frames.
 //
-// What: after each collider response pass (Cloth runs the vertex pass once more when faces were
-// moved, so that the vertices keep the last word: a corner pushed out of one body can land in
-// another), every triangle whose bounding box reaches a sphere or
-// capsule is tested against the body's core (the sphere's centre, the capsule's segment) with the
-// segment–triangle closest-point kernel (Proximity.h), in the body's frame. A face point deeper
-// in the body than the allowance (Cloth passes the contact thickness) is moved out along the
-// contact normal to that depth by moving the three corners, each by its barycentric weight b_k
-// and inverse mass w_k: Δx_k = b_k w_k / (Σ_j b_j² w_j) · depth · n, which moves the face point
-// by exactly depth · n (the impulse distribution of Bridson, Fedkiw & Anderson 2002 for a
-// point–triangle contact, with the body infinitely heavy). Why an allowance: the vertices keep
-// the thickness outside the body, and a coarse mesh over a curved body sags between them by
-// l² / (8 R) (3.8 mm for 5 cm edges on the 8 cm pusher of stress scene 7); pushing those faces
-// out would lift the vertices off wherever a coarse mesh lies on a curved body and change
-// ordinary draping for nothing, while a face that a thin body passes through is caught long
-// before the core. With the thickness as the allowance the curtain has no face contact at all
-// (its state hash is unchanged).
-// Contacts are resolved one after the other in triangle order (Gauss–Seidel; serial, so the same
-// bits on any thread count) and swept again while a sweep still moved a face, a few times at
-// most (neighbouring faces share corners). Then, once, each face point's velocity into the body
-// (relative to the body's surface there) is removed the same way (inelastic); removed in every
-// sweep, the pushes of the successive contacts of one face added up and the face left faster
-// than the body (a rod rising at 1.8 m/s into a face sent its corners off at up to 2.5 m/s).
+// What: each body is reduced to cores, segments in its frame that faces keep a reach away from:
+// a sphere's centre (a segment of length 0) and a capsule's axis, reach = radius − allowance; a
+// box's twelve edges, reach = allowance / 2 (a flat face of a box cannot pass between the
+// vertices; its edges can). Cloth passes the contact thickness as the allowance. Why an allowance
+// for round bodies: the vertices keep the thickness outside, and a coarse mesh over a curved body
+// sags between them by l² / (8 R) (3.8 mm for 5 cm edges on the 8 cm pusher of stress scene 7);
+// pushing those faces out would lift the vertices off wherever a coarse mesh lies on a curved
+// body and change ordinary draping for nothing, while a face that a thin body passes through is
+// caught long before the core. With it the curtain has no face contact at all (its state hash is
+// unchanged). Why half of it for box edges: a face resting on a box's flat face is a thickness
+// from its edges; half keeps it on its side of an edge it bends round, with room to tell the side
+// at the next step.
 //
-// Which side: a face point that reached the core (distance 0) or crossed it within the step has
-// no normal of its own, or the wrong one. The normal of the same test at the step start (the
-// start positions in the body's start frame) decides then: the face goes back to the side it came
-// from, as the vertices' continuous test sends them.
+// Contact points of a face and a core (facePoints), in the body's frame: over the face's interior,
+// the part of the core inside the triangle's prism is a line whose height over the face is
+// linear, so its two ends are the deepest points (a box edge or a capsule parallel to the face
+// touches it along a line; the kernel's single closest point, on the face's edge, pushed one end
+// of that line and tilted the face about the other); beside the face, the closest points of the
+// segment and the triangle (Proximity.h) when they lie on the face's boundary. A face point short
+// of the reach is moved out along the contact normal by moving the three corners, each by its
+// barycentric weight b_k and inverse mass w_k: Δx_k = b_k w_k / (Σ_j b_j² w_j) · depth · n, which
+// moves the face point by exactly depth · n (the impulse distribution of Bridson, Fedkiw &
+// Anderson 2002 for a point–triangle contact, with the body infinitely heavy). Contacts are
+// resolved one after the other in triangle order (Gauss–Seidel; serial, so the same bits on any
+// thread count) and swept again while a sweep still moved a face, four times at most
+// (neighbouring faces share corners). Cloth then runs the vertex pass once more, so that the
+// vertices keep the last word (a corner pushed out of one body can land in another).
 //
-// The strain limiter in contact holds each contact one-sided (holds(): n · Σ b_k x_k ≥
-// n · c + R − allowance, c the core point), as it holds heavy self-contacts, so that its rounds
-// slide the cloth round the body instead of pulling the face back into it (on the rod of the
-// test, max strain 0.101 with the holds, 0.103 without).
+// Which side: a face that crossed a core within the step (its normal now points through the
+// body, or it lies on the core) goes back to the side it came from: the normal of the closest
+// points at the step start, in the body's start frame, as the vertices' continuous test sends
+// them. Such a face is in contact however far past the core it went (a box edge has no radius to
+// catch it by), so the candidates are the faces whose path over the step, start and end, reaches
+// a core's box (a sheet falling at 1.4 m/s moves 2.3 cm a step, past a 2 cm plank).
 //
-// Not covered: boxes and triangle-mesh colliders (their corners and edges can still poke through
-// a face; their faces are flat, so a cloth face cannot pass a flat face between its vertices, and
-// a plane never), and a body that passes through a whole face within one step (faster than its
-// radius per step relative to the cloth: the vertices' continuous test still catches the corners).
+// After the sweeps, once: every face point in contact, and every point of a face the sweeps
+// pushed, keeps no velocity into the body (inelastic, relative to the body's surface there;
+// removed in every sweep, the pushes of the successive contacts of one face added up and the
+// face left faster than the body: a rod rising at 1.8 m/s into a face sent its corners off at up
+// to 2.5 m/s), and is held one-sided in the strain limiter in contact (holds(): n · Σ b_k x_k ≥
+// n · c + reach, c the core point), as it holds heavy self-contacts, so that its rounds slide the
+// cloth round the body instead of pulling the face back into it (on the rod of the test, max
+// strain 0.101 with the holds, 0.103 without).
+//
+// Not covered: triangle-mesh colliders (their edges can still poke through a face between its
+// vertices), friction on face contacts (the vertex pass takes it), and a face inside a body at
+// both ends of a step with no side to return to.
 #pragma once
 
 #include "ColliderResponse.h"
@@ -63,17 +72,26 @@
 
 namespace weft {
 
+/// A segment in a body's frame (a point when both ends are equal) that faces keep `reach` (m)
+/// away from: a sphere's centre, a capsule's axis, a box's edge.
+struct FaceCore {
+  Vec3 start = Vec3::Zero();
+  Vec3 end = Vec3::Zero();
+  Real reach = 0;
+};
+
 /// What one resolve() did.
 struct ColliderFaceReport {
-  Index contacts = 0;  ///< face–body contacts found in the first sweep
+  Index contacts = 0;  ///< faces pushed out of a body (a face and a core: one contact)
   Index sweeps = 0;    ///< sweeps over the contacts (the first included)
 };
 
-/// Keeps cloth faces out of sphere and capsule colliders (see the design note).
+/// Keeps cloth faces out of sphere, capsule and box colliders (see the design note).
 class ColliderFaceContacts {
  public:
-  /// Moves faces of `triangles` that are deeper than `allowance` (m) inside a sphere or capsule
-  /// of `colliders` out to that depth, and removes their velocity into it. `xStart`: positions at the step start (which
+  /// Moves faces of `triangles` that are within reach of a sphere's, capsule's or box's core
+  /// (see the design note; `allowance` in m, Cloth passes the contact thickness) back out of it,
+  /// and removes their velocity into the body. `xStart`: positions at the step start (which
   /// side a face came from). Vertices with inverse mass 0 (pins) are not moved.
   ColliderFaceReport resolve(std::span<const ColliderFrame> colliders,
                              std::span<const TriangleRest> triangles, const Vec3Array& xStart,
@@ -90,11 +108,12 @@ class ColliderFaceContacts {
   struct Candidate {
     Index triangle = 0;
     Index collider = 0;
-    bool touched = false;  // corrected in some sweep of this resolve()
-    SeparationHold hold;   // from its last correction
-    Vec3 barycentric = Vec3::Zero();  // of the face point at its last correction
+    Index core = 0;                // into m_cores
+    Vec3 cameFrom = Vec3::Zero();  // body frame: the core-to-face normal at the step start
+    bool pushed = false;           // moved by a sweep of this resolve()
   };
-  std::vector<Candidate> m_candidates;  // triangles whose box reaches a body, this resolve()
+  std::vector<FaceCore> m_cores;         // every body's cores, this resolve()
+  std::vector<Candidate> m_candidates;  // a face and a core it may touch, this resolve()
   std::vector<SeparationHold> m_holds;
 };
 

@@ -142,7 +142,7 @@ struct RodDrop {
   Real deepestFace = 0;    // m into the rod (negative: outside)
   Real maxStrain = 0;
 };
-RodDrop dropOnRod(bool faceContacts, int frames) {
+RodDrop dropOnRod(bool faceContacts, int frames, bool plank = false) {
   const Index n = 11;
   auto model = horizontalSquare(n, 0.5, 0.5);
   World world;
@@ -154,18 +154,37 @@ RodDrop dropOnRod(bool faceContacts, int frames) {
   pose.pose.position = Vec3(0.013, 0.38, 0);
   pose.pose.rotation = Quat::FromTwoVectors(Vec3::UnitY(), Vec3::UnitZ());
   constexpr Real kRadius = 0.02;
-  EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
+  // The plank: a box 2 cm square in section along z, its top where the rod's top is.
+  RigidMotion plankPose;
+  plankPose.pose.position = Vec3(0.013, 0.39, 0);
+  if (plank) {
+    EXPECT_TRUE(world.addCollider(Box::create(Vec3(0.01, 0.01, 0.5), plankPose).value()).ok());
+  } else {
+    EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
+  }
   RodDrop result;
   for (int frame = 0; frame < frames; ++frame) {
     EXPECT_EQ(world.step(1.0 / 60), StepStatus::Ok);
     result.maxStrain = std::max(result.maxStrain, world.stats().maxStrain);
     const std::span<const Vec3> x = world.positions(cloth).value();
     for (const TriangleRest& t : model->triangles()) {
-      const Real gap = closestPointsOnSegmentAndTriangle(Vec3(0.013, 0.38, -0.5),
-                                                         Vec3(0.013, 0.38, 0.5), x[t.vertices[0]],
-                                                         x[t.vertices[1]], x[t.vertices[2]])
-                           .distance;
-      result.deepestFace = std::max(result.deepestFace, kRadius - gap);
+      const Vec3& a = x[t.vertices[0]];
+      const Vec3& b = x[t.vertices[1]];
+      const Vec3& c = x[t.vertices[2]];
+      if (plank) {
+        // How far the plank's top edges (z-long, at x = 0.003 and 0.023, y = 0.40) are into the
+        // face's underside: positive when an edge is above a face point right over it.
+        for (Real edgeX : {0.003, 0.023}) {
+          const SegmentTriangleClosestPoints gap = closestPointsOnSegmentAndTriangle(
+              Vec3(edgeX, 0.40, -0.5), Vec3(edgeX, 0.40, 0.5), a, b, c);
+          if (gap.distance == 0) result.deepestFace = std::max(result.deepestFace, kRadius);
+        }
+      } else {
+        const Real gap =
+            closestPointsOnSegmentAndTriangle(Vec3(0.013, 0.38, -0.5), Vec3(0.013, 0.38, 0.5), a, b, c)
+                .distance;
+        result.deepestFace = std::max(result.deepestFace, kRadius - gap);
+      }
     }
   }
   const std::span<const Vec3> x = world.positions(cloth).value();
@@ -187,6 +206,42 @@ TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
   const RodDrop vertices = dropOnRod(false, 40);
   EXPECT_LT(vertices.middleLowest, 0.2) << "the rod no longer passes through the faces";
   EXPECT_GT(vertices.deepestFace, 0.01);
+}
+
+TEST(ColliderFaceContacts, ASheetHangsOnAPlankThinnerThanItsTriangles) {
+  // A box 2 cm square in section: its edges have no radius, so a face is in contact when one
+  // crossed it within the step, and goes back to where it came from.
+  const RodDrop faces = dropOnRod(true, 40, /*plank=*/true);
+  EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the plank";
+  EXPECT_EQ(faces.deepestFace, 0) << "a top edge of the plank crossed a face";
+  EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
+  const RodDrop vertices = dropOnRod(false, 40, /*plank=*/true);
+  EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
+}
+
+TEST(ColliderFaceContacts, ABoxEdgeThatCrossedAFaceIsPutBackOnTheSideTheFaceCameFrom) {
+  // A box whose top edges run along z at x = ±0.02, y = 0.02; the face started 1 cm above them
+  // and ended 1 cm below their height (all its corners outside the box: it is much wider).
+  Shape box = Box::create(Vec3(0.02, 0.02, 0.5)).value();
+  const ColliderFrame collider{&box, RigidMotion{}, RigidMotion{}, 0.3};
+  Vec3Array x, v(3, Vec3(0, -1.2, 0)), xStart;
+  (void)oneTriangle(xStart, 0.03);
+  const auto triangles = oneTriangle(x, 0.01);
+  const std::vector<Real> inverseMasses{1, 1, 1};
+  const Real allowance = 0.003;
+  ColliderFaceContacts faces;
+  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
+                                                  triangles, xStart, inverseMasses, allowance, x, v);
+  EXPECT_GE(report.contacts, 1);
+  // Back above the top edges, by half the allowance (edges have no radius), and no longer moving
+  // down.
+  for (Real edgeX : {-0.02, 0.02}) {
+    const SegmentTriangleClosestPoints gap = closestPointsOnSegmentAndTriangle(
+        Vec3(edgeX, 0.02, -0.5), Vec3(edgeX, 0.02, 0.5), x[0], x[1], x[2]);
+    EXPECT_GT(gap.distance, 0.5 * allowance - 1e-6) << "edge at x = " << edgeX;
+    EXPECT_GT(gap.pointOnTriangle.y(), gap.pointOnSegment.y()) << "edge at x = " << edgeX;
+  }
+  EXPECT_GE(v[0].y() + v[1].y() + v[2].y(), -1e-12);
 }
 
 }  // namespace
