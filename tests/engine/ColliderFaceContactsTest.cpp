@@ -33,18 +33,30 @@ Real coreDistance(const Vec3Array& x) {
   return closestPointOnTriangle(Vec3::Zero(), x[0], x[1], x[2]).distance;
 }
 
+// The contact thickness Cloth passes as the allowance.
+constexpr Real kAllowance = 0.003;
+
+// One resolve() of `faces` against the single body `shape`, at rest at its pose.
+ColliderFaceReport resolveAgainst(ColliderFaceContacts& faces, Shape& shape,
+                                  std::span<const TriangleRest> triangles, const Vec3Array& xStart,
+                                  std::span<const Real> inverseMasses, Real allowance, Vec3Array& x,
+                                  Vec3Array& v) {
+  const ColliderFrame collider{&shape, motion(shape), motion(shape), 0.3};
+  return faces.resolve(std::span<const ColliderFrame>(&collider, 1), triangles, xStart,
+                       inverseMasses, allowance, x, v);
+}
+
 TEST(ColliderFaceContacts, PushesAFaceOutOfASphereBetweenItsVertices) {
   // A 5 cm ball under the middle of the face, 2 cm into it; every vertex is far outside it.
   Shape ball = Sphere::create(0.05).value();
-  const ColliderFrame collider{&ball, RigidMotion{}, RigidMotion{}, 0.3};
   Vec3Array x, v(3, Vec3(0, -1, 0));
   const auto triangles = oneTriangle(x, 0.03);
   const Vec3Array xStart = {x[0] + Vec3(0, 0.1, 0), x[1] + Vec3(0, 0.1, 0), x[2] + Vec3(0, 0.1, 0)};
   const std::vector<Real> inverseMasses{1, 1, 1};
-  const Real allowance = 0.003;
+  const Real allowance = kAllowance;
   ColliderFaceContacts faces;
-  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
-                                                  triangles, xStart, inverseMasses, allowance, x, v);
+  const ColliderFaceReport report =
+      resolveAgainst(faces, ball, triangles, xStart, inverseMasses, allowance, x, v);
   EXPECT_EQ(report.contacts, 1);
   // Out to the radius less the allowance, straight up (the face is level over the centre).
   EXPECT_NEAR(coreDistance(x), 0.05 - allowance, 1e-12);
@@ -66,15 +78,13 @@ TEST(ColliderFaceContacts, PushesAFaceOutOfASphereBetweenItsVertices) {
 
 TEST(ColliderFaceContacts, PinnedCornersStayAndTheOthersTakeTheCorrection) {
   Shape ball = Sphere::create(0.05).value();
-  const ColliderFrame collider{&ball, RigidMotion{}, RigidMotion{}, 0.3};
   Vec3Array x, v(3, Vec3::Zero());
   const auto triangles = oneTriangle(x, 0.03);
   const Vec3Array xStart = x;
   const Vec3 pinned = x[0];
   const std::vector<Real> inverseMasses{0, 1, 1};
   ColliderFaceContacts faces;
-  (void)faces.resolve(std::span<const ColliderFrame>(&collider, 1), triangles, xStart,
-                      inverseMasses, 0.0, x, v);
+  (void)resolveAgainst(faces, ball, triangles, xStart, inverseMasses, 0.0, x, v);
   EXPECT_EQ(x[0], pinned);
   EXPECT_NEAR(coreDistance(x), 0.05, 1e-6);  // swept a few times: the tilted face settles
   // All three pinned: nothing can move, nothing is done.
@@ -82,8 +92,8 @@ TEST(ColliderFaceContacts, PinnedCornersStayAndTheOthersTakeTheCorrection) {
   const auto again = oneTriangle(still, 0.03);
   const Vec3Array before = still;
   const std::vector<Real> allPinned{0, 0, 0};
-  const ColliderFaceReport none = faces.resolve(std::span<const ColliderFrame>(&collider, 1), again,
-                                                before, allPinned, 0.0, still, v);
+  const ColliderFaceReport none =
+      resolveAgainst(faces, ball, again, before, allPinned, 0.0, still, v);
   EXPECT_EQ(none.contacts, 0);
   EXPECT_EQ(still, before);
 }
@@ -92,14 +102,13 @@ TEST(ColliderFaceContacts, AFaceThatCrossedTheCoreGoesBackToTheSideItCameFrom) {
   // The face started 1 cm above the centre of a 5 cm ball and ended 1 cm below it (its vertices
   // are outside the ball throughout): its own normal at the end points down, through the ball.
   Shape ball = Sphere::create(0.05).value();
-  const ColliderFrame collider{&ball, RigidMotion{}, RigidMotion{}, 0.3};
   Vec3Array x, v(3, Vec3(0, -1.2, 0)), xStart;
   (void)oneTriangle(xStart, 0.01);
   const auto triangles = oneTriangle(x, -0.01);
   const std::vector<Real> inverseMasses{1, 1, 1};
   ColliderFaceContacts faces;
-  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
-                                                  triangles, xStart, inverseMasses, 0.0, x, v);
+  const ColliderFaceReport report =
+      resolveAgainst(faces, ball, triangles, xStart, inverseMasses, 0.0, x, v);
   EXPECT_EQ(report.contacts, 1);
   EXPECT_NEAR(x[0].y(), 0.05, 1e-12);  // above the ball, where it came from
   EXPECT_NEAR(v[0].y(), 0, 1e-12);
@@ -223,15 +232,14 @@ TEST(ColliderFaceContacts, ABoxEdgeThatCrossedAFaceIsPutBackOnTheSideTheFaceCame
   // A box whose top edges run along z at x = ±0.02, y = 0.02; the face started 1 cm above them
   // and ended 1 cm below their height (all its corners outside the box: it is much wider).
   Shape box = Box::create(Vec3(0.02, 0.02, 0.5)).value();
-  const ColliderFrame collider{&box, RigidMotion{}, RigidMotion{}, 0.3};
   Vec3Array x, v(3, Vec3(0, -1.2, 0)), xStart;
   (void)oneTriangle(xStart, 0.03);
   const auto triangles = oneTriangle(x, 0.01);
   const std::vector<Real> inverseMasses{1, 1, 1};
-  const Real allowance = 0.003;
+  const Real allowance = kAllowance;
   ColliderFaceContacts faces;
-  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
-                                                  triangles, xStart, inverseMasses, allowance, x, v);
+  const ColliderFaceReport report =
+      resolveAgainst(faces, box, triangles, xStart, inverseMasses, allowance, x, v);
   EXPECT_GE(report.contacts, 1);
   // Back above the top edges, by half the allowance (edges have no radius), and no longer moving
   // down.
