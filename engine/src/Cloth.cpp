@@ -723,7 +723,7 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
         if (spansHeldMassRatio(hold, m_inverseMasses)) m_heldSeparations.push_back(hold);
       }
     }
-    // Faces on a sphere, capsule or box are held one-sided too (ColliderFaceContacts): the limiter
+    // Faces on a collider are held one-sided too (ColliderFaceContacts): the limiter
     // slides them round the body instead of pulling them back into it.
     const std::span<const SeparationHold> faceHolds = m_faceContacts.holds();
     m_heldSeparations.insert(m_heldSeparations.end(), faceHolds.begin(), faceHolds.end());

@@ -200,7 +200,7 @@ class Cloth final : public DynamicSystem {
   // nothing was over).
   Index limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bool selfCollision,
                              Index edgesOverLimit, ClothFrameReport& report);
-  // Keeps faces out of spheres, capsules and boxes (ColliderFaceContacts) after a collider pass,
+  // Keeps faces out of the colliders (ColliderFaceContacts) after a collider pass,
   // and then the vertices out of every collider again; returns the face contacts.
   Index resolveFaceContacts();
   // The colliders near the substep's start and current positions, into m_nearColliders.

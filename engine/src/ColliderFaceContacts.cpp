@@ -21,7 +21,8 @@ constexpr Real kSettledDepth = 1e-9;
 // The cores of a body in its own frame that faces are kept away from (see the design note): a
 // sphere's centre (a segment of length 0) and a capsule's segment, each `radius` − allowance; a
 // box's twelve edges, half the allowance (a face need not keep the thickness from an edge that
-// pokes into it between its vertices, only stay on its side). Appends to `cores`.
+// pokes into it between its vertices, only stay on its side). Appends to `cores`; a mesh's
+// edges are found per face (resolve()).
 void appendCores(const Shape& shape, Real allowance, std::vector<FaceCore>& cores) {
   if (const Sphere* sphere = std::get_if<Sphere>(&shape)) {
     cores.push_back({Vec3::Zero(), Vec3::Zero(), sphere->radius() - allowance});
@@ -151,7 +152,9 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
   for (Index k = 0; k < Index(colliders.size()); ++k) {
     const Index firstCore = Index(m_cores.size());
     appendCores(*colliders[k].shape, allowance, m_cores);
-    if (Index(m_cores.size()) == firstCore) continue;  // a plane or a mesh: vertices only
+    const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(colliders[k].shape);
+    const Index lastCore = Index(m_cores.size());
+    if (lastCore == firstCore && !mesh) continue;  // a plane: vertices only
     const Aabb body = bounds(*colliders[k].shape);
     const Pose& endPose = colliders[k].end.pose;
     const Pose& startPose = colliders[k].start.pose;
@@ -178,7 +181,31 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         path.expand(startLocal[j]);
         path.expand(endPose.toLocal(x[corner[j]]));
       }
-      for (Index c = firstCore; c < Index(m_cores.size()); ++c) {
+      Index coresBegin = firstCore, coresEnd = lastCore;
+      if (mesh) {
+        // A mesh's cores are the edges of its triangles near this face's path, one core per edge
+        // (an edge of two triangles is met twice).
+        Aabb near = path;
+        near.inflate(0.5 * allowance);
+        m_meshTriangles.clear();
+        mesh->localBvh().queryBox(near, m_meshTriangles);
+        m_meshEdges.clear();
+        for (Index meshTriangle : m_meshTriangles) {
+          for (int j = 0; j < 3; ++j) {
+            const Index a = mesh->indices()[3 * meshTriangle + j];
+            const Index b = mesh->indices()[3 * meshTriangle + (j + 1) % 3];
+            m_meshEdges.push_back({std::min(a, b), std::max(a, b)});
+          }
+        }
+        std::sort(m_meshEdges.begin(), m_meshEdges.end());
+        m_meshEdges.erase(std::unique(m_meshEdges.begin(), m_meshEdges.end()), m_meshEdges.end());
+        coresBegin = Index(m_cores.size());
+        for (const auto& [a, b] : m_meshEdges) {
+          m_cores.push_back({mesh->localVertices()[a], mesh->localVertices()[b], 0.5 * allowance});
+        }
+        coresEnd = Index(m_cores.size());
+      }
+      for (Index c = coresBegin; c < coresEnd; ++c) {
         const FaceCore& core = m_cores[c];
         Aabb reach = Aabb::empty();
         reach.expand(core.start);

@@ -1,5 +1,5 @@
 // ColliderFaceContacts: keeps the faces of a cloth, not only its vertices, out of spheres,
-// capsules and boxes.
+// capsules, boxes and triangle meshes.
 //
 // Design note
 // -----------
@@ -7,15 +7,15 @@
 // but a triangle is more than its corners. Where a body is thinner than the cloth's triangles —
 // a capsule of 2 cm radius or a 2 cm plank under edges of 3–5 cm — the body passes between the
 // vertices through a face while every vertex stays outside. Measured: a 0.5 m cotton square of
-// 11 × 11 vertices dropped onto a rod of 2 cm radius, or onto a plank 2 cm square in section,
-// fell straight through it (ColliderFaceContactsTest); in stress scene 7 (three sheets pushed
+// 11 × 11 vertices dropped onto a rod of 2 cm radius, or onto a plank 2 cm square in section (a
+// box or a triangle mesh), fell straight through it (ColliderFaceContactsTest); in stress scene 7 (three sheets pushed
 // through a ring of capsules) the worst edges ran straight through a capsule of the ring, one end
 // inside the ring and one outside, with a face at the capsule's core in 33–44 of the 150 frames.
 //
 // What: each body is reduced to cores, segments in its frame that faces keep a reach away from:
 // a sphere's centre (a segment of length 0) and a capsule's axis, reach = radius − allowance; a
-// box's twelve edges, reach = allowance / 2 (a flat face of a box cannot pass between the
-// vertices; its edges can). Cloth passes the contact thickness as the allowance. Why an allowance
+// box's twelve edges and a mesh's edges near the face (found in its tree per face), reach =
+// allowance / 2 (a flat face of a body cannot pass between the vertices; its edges can). Cloth passes the contact thickness as the allowance. Why an allowance
 // for round bodies: the vertices keep the thickness outside, and a coarse mesh over a curved body
 // sags between them by l² / (8 R) (3.8 mm for 5 cm edges on the 8 cm pusher of stress scene 7);
 // pushing those faces out would lift the vertices off wherever a coarse mesh lies on a curved
@@ -56,8 +56,8 @@
 // cloth round the body instead of pulling the face back into it (on the rod of the test, max
 // strain 0.101 with the holds, 0.103 without).
 //
-// Not covered: triangle-mesh colliders (their edges can still poke through a face between its
-// vertices), friction on face contacts (the vertex pass takes it), and a face inside a body at
+// Not covered: a mesh's vertices poking into a face without an edge crossing it (a spike
+// narrower than the triangles), friction on face contacts (the vertex pass takes it), and a face inside a body at
 // both ends of a step with no side to return to.
 #pragma once
 
@@ -68,12 +68,13 @@
 #include <weft/engine/ClothModel.h>
 
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace weft {
 
 /// A segment in a body's frame (a point when both ends are equal) that faces keep `reach` (m)
-/// away from: a sphere's centre, a capsule's axis, a box's edge.
+/// away from: a sphere's centre, a capsule's axis, an edge of a box or a mesh.
 struct FaceCore {
   Vec3 start = Vec3::Zero();
   Vec3 end = Vec3::Zero();
@@ -86,10 +87,11 @@ struct ColliderFaceReport {
   Index sweeps = 0;    ///< sweeps over the contacts (the first included)
 };
 
-/// Keeps cloth faces out of sphere, capsule and box colliders (see the design note).
+/// Keeps cloth faces out of sphere, capsule, box and triangle-mesh colliders (see the design
+/// note).
 class ColliderFaceContacts {
  public:
-  /// Moves faces of `triangles` that are within reach of a sphere's, capsule's or box's core
+  /// Moves faces of `triangles` that are within reach of a core of a sphere, capsule, box or mesh
   /// (see the design note; `allowance` in m, Cloth passes the contact thickness) back out of it,
   /// and removes their velocity into the body. `xStart`: positions at the step start (which
   /// side a face came from). Vertices with inverse mass 0 (pins) are not moved.
@@ -113,6 +115,8 @@ class ColliderFaceContacts {
     bool pushed = false;           // moved by a sweep of this resolve()
   };
   std::vector<FaceCore> m_cores;         // every body's cores, this resolve()
+  std::vector<Index> m_meshTriangles;    // a mesh's triangles near one face
+  std::vector<std::pair<Index, Index>> m_meshEdges;  // their edges, each once
   std::vector<Candidate> m_candidates;  // a face and a core it may touch, this resolve()
   std::vector<SeparationHold> m_holds;
 };

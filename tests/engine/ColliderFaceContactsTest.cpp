@@ -7,6 +7,7 @@
 #include "ContactTestSupport.h"
 
 #include <weft/collision/Proximity.h>
+#include <weft/collision/TriangleMeshShape.h>
 #include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
 
@@ -151,7 +152,23 @@ struct RodDrop {
   Real deepestFace = 0;    // m into the rod (negative: outside)
   Real maxStrain = 0;
 };
-RodDrop dropOnRod(bool faceContacts, int frames, bool plank = false) {
+enum class Support { Rod, Plank, MeshPlank };
+
+// A box of `halfExtents` as a closed triangle mesh (counter-clockwise seen from outside).
+TriangleMeshShape boxMesh(const Vec3& halfExtents, const RigidMotion& pose) {
+  std::vector<Vec3> corners;
+  for (int corner = 0; corner < 8; ++corner) {
+    corners.emplace_back((corner & 4) ? halfExtents.x() : -halfExtents.x(),
+                         (corner & 2) ? halfExtents.y() : -halfExtents.y(),
+                         (corner & 1) ? halfExtents.z() : -halfExtents.z());
+  }
+  const std::vector<Index> indices = {4, 6, 7, 4, 7, 5,  0, 1, 3, 0, 3, 2,  2, 3, 7, 2, 7, 6,
+                                      0, 4, 5, 0, 5, 1,  1, 5, 7, 1, 7, 3,  0, 2, 6, 0, 6, 4};
+  return TriangleMeshShape::create(corners, indices, pose).value();
+}
+
+RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod) {
+  const bool plank = support != Support::Rod;
   const Index n = 11;
   auto model = horizontalSquare(n, 0.5, 0.5);
   World world;
@@ -166,8 +183,10 @@ RodDrop dropOnRod(bool faceContacts, int frames, bool plank = false) {
   // The plank: a box 2 cm square in section along z, its top where the rod's top is.
   RigidMotion plankPose;
   plankPose.pose.position = Vec3(0.013, 0.39, 0);
-  if (plank) {
+  if (support == Support::Plank) {
     EXPECT_TRUE(world.addCollider(Box::create(Vec3(0.01, 0.01, 0.5), plankPose).value()).ok());
+  } else if (support == Support::MeshPlank) {
+    EXPECT_TRUE(world.addCollider(boxMesh(Vec3(0.01, 0.01, 0.5), plankPose)).ok());
   } else {
     EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
   }
@@ -220,11 +239,21 @@ TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
 TEST(ColliderFaceContacts, ASheetHangsOnAPlankThinnerThanItsTriangles) {
   // A box 2 cm square in section: its edges have no radius, so a face is in contact when one
   // crossed it within the step, and goes back to where it came from.
-  const RodDrop faces = dropOnRod(true, 40, /*plank=*/true);
+  const RodDrop faces = dropOnRod(true, 40, Support::Plank);
   EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the plank";
   EXPECT_EQ(faces.deepestFace, 0) << "a top edge of the plank crossed a face";
   EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
-  const RodDrop vertices = dropOnRod(false, 40, /*plank=*/true);
+  const RodDrop vertices = dropOnRod(false, 40, Support::Plank);
+  EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
+}
+
+TEST(ColliderFaceContacts, ASheetHangsOnAMeshPlankThinnerThanItsTriangles) {
+  // The same plank as a triangle mesh: its cores are the edges of its triangles near each face.
+  const RodDrop faces = dropOnRod(true, 40, Support::MeshPlank);
+  EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the plank";
+  EXPECT_EQ(faces.deepestFace, 0) << "a top edge of the plank crossed a face";
+  EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
+  const RodDrop vertices = dropOnRod(false, 40, Support::MeshPlank);
   EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
 }
 

@@ -86,11 +86,11 @@ struct ClothSettings {
   /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
-  /// Keeps the cloth's faces, not only its vertices, out of sphere, capsule and box colliders: a
+  /// Keeps the cloth's faces, not only its vertices, out of every collider but a plane: a
   /// body thinner than the triangles (a 2 cm rod or plank under 5 cm edges) otherwise passes
   /// between the vertices, and the cloth falls through it or hangs on it by a stretched edge.
-  /// Costs a box test per triangle per nearby sphere, capsule or box per collision pass, and
-  /// closest-point tests near the body; turn off only for meshes much finer than every collider.
+  /// Costs a box test per triangle per nearby collider per collision pass (and a tree query for
+  /// a mesh), and closest-point tests near the body; turn off only for meshes much finer than every collider.
   bool faceContacts = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
   /// Keeps the cloth from passing through other cloths of the world that have this switch on
