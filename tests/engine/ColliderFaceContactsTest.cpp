@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cstdint>
 
 namespace weft {
 namespace {
@@ -151,6 +152,7 @@ struct RodDrop {
   Real middleLowest = 0;   // m
   Real deepestFace = 0;    // m into the rod (negative: outside)
   Real maxStrain = 0;
+  std::uint64_t stateHash = 0;  // World::stateHash() at the end
 };
 enum class Support { Rod, Plank, MeshPlank };
 
@@ -167,11 +169,13 @@ TriangleMeshShape boxMesh(const Vec3& halfExtents, const RigidMotion& pose) {
   return TriangleMeshShape::create(corners, indices, pose).value();
 }
 
-RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod) {
+RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod, int threads = 1) {
   const bool plank = support != Support::Rod;
   const Index n = 11;
   auto model = horizontalSquare(n, 0.5, 0.5);
-  World world;
+  WorldSettings worldSettings;
+  worldSettings.threadCount = threads;
+  World world(worldSettings);
   ClothSettings settings;
   settings.material = cottonFabric();
   settings.faceContacts = faceContacts;
@@ -215,6 +219,7 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod)
       }
     }
   }
+  result.stateHash = world.stateHash();
   const std::span<const Vec3> x = world.positions(cloth).value();
   result.middleLowest = std::numeric_limits<Real>::infinity();
   for (Index row = 0; row < n; ++row) result.middleLowest = std::min(result.middleLowest, x[row * n + n / 2].y());
@@ -255,6 +260,13 @@ TEST(ColliderFaceContacts, ASheetHangsOnAMeshPlankThinnerThanItsTriangles) {
   EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
   const RodDrop vertices = dropOnRod(false, 40, Support::MeshPlank);
   EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
+}
+
+TEST(ColliderFaceContacts, AreBitwiseTheSameOnOneAndTwoThreads) {
+  for (Support support : {Support::Rod, Support::Plank, Support::MeshPlank}) {
+    EXPECT_EQ(dropOnRod(true, 40, support, 1).stateHash, dropOnRod(true, 40, support, 2).stateHash)
+        << "support " << int(support);
+  }
 }
 
 TEST(ColliderFaceContacts, ABoxEdgeThatCrossedAFaceIsPutBackOnTheSideTheFaceCameFrom) {
