@@ -160,7 +160,8 @@ SegmentTriangleClosestPoints closestPointsOnSegmentAndTriangle(const Vec3& p0, c
   // Does the segment cross the triangle? Its ends on opposite sides of the plane (or one on it),
   // and the crossing point inside. A degenerate triangle has no plane: its edges answer below.
   const Vec3 normal = (b - a).cross(c - a);
-  const Real scale = std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
+  const Real scale =
+      std::max({(b - a).squaredNorm(), (c - a).squaredNorm(), (c - b).squaredNorm()});
   if (normal.squaredNorm() > 1e-12 * scale * scale) {
     const Real side0 = normal.dot(p0 - a), side1 = normal.dot(p1 - a);
     if ((side0 <= 0 && side1 >= 0) || (side0 >= 0 && side1 <= 0)) {

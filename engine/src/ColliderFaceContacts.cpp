@@ -19,16 +19,22 @@ constexpr int kMaxSweeps = 4;
 constexpr Real kSettledDepth = 1e-9;
 
 // The cores of a body in its own frame that faces are kept away from (see the design note): a
-// sphere's centre (a segment of length 0) and a capsule's segment, each `radius` − allowance; a
+// sphere's centre (a segment of length 0) and a capsule's segment, each `radius` − allowance (at
+// least half the allowance); a
 // box's twelve edges, half the allowance (a face need not keep the thickness from an edge that
 // pokes into it between its vertices, only stay on its side). Appends to `cores`; a mesh's
 // edges are found per face (resolve()).
 void appendCores(const Shape& shape, Real allowance, std::vector<FaceCore>& cores) {
+  // A ball or capsule thinner than the allowance is kept away from as an edge is: a negative
+  // reach would let a face rest past the core, on the far side it must not reach.
+  const auto roundReach = [&](Real radius) {
+    return std::max(radius - allowance, 0.5 * allowance);
+  };
   if (const Sphere* sphere = std::get_if<Sphere>(&shape)) {
-    cores.push_back({Vec3::Zero(), Vec3::Zero(), sphere->radius() - allowance});
+    cores.push_back({Vec3::Zero(), Vec3::Zero(), roundReach(sphere->radius())});
   } else if (const Capsule* capsule = std::get_if<Capsule>(&shape)) {
     const Vec3 half(0, capsule->halfLength(), 0);
-    cores.push_back({-half, half, capsule->radius() - allowance});
+    cores.push_back({-half, half, roundReach(capsule->radius())});
   } else if (const Box* box = std::get_if<Box>(&shape)) {
     const Vec3& e = box->halfExtents();
     for (int axis = 0; axis < 3; ++axis) {
@@ -87,7 +93,7 @@ int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const 
     for (int edge = 0; edge < 3 && low <= high; ++edge) {
       const Vec3& from = *corners[edge];
       const Vec3& to = *corners[(edge + 1) % 3];
-      const Vec3 inward = up.cross(to - from);  // points into the triangle (counter-clockwise about up)
+      const Vec3 inward = up.cross(to - from);  // into the triangle (counter-clockwise about up)
       const Real at = inward.dot(core.start - from), rate = inward.dot(segment);
       if (rate == 0) {
         if (at < 0) high = -1;  // parallel to this edge and outside
@@ -108,7 +114,8 @@ int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const 
         if (side == 0) continue;  // on the face, with no start to tell the side
         const Vec3 onPlane = corePoint - height * up;
         // Barycentric weights from the sub-triangle areas (clamped: the point is in the prism).
-        Vec3 weights((b - onPlane).cross(c - onPlane).dot(up), (c - onPlane).cross(a - onPlane).dot(up),
+        Vec3 weights((b - onPlane).cross(c - onPlane).dot(up),
+                     (c - onPlane).cross(a - onPlane).dot(up),
                      (a - onPlane).cross(b - onPlane).dot(up));
         weights = weights.cwiseMax(0);
         const Real total = weights.sum();

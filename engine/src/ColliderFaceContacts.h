@@ -1,29 +1,29 @@
 // ColliderFaceContacts: keeps the faces of a cloth, not only its vertices, out of spheres,
 // capsules, boxes and triangle meshes.
 //
-// Design note
-// -----------
-// Why: ColliderResponse keeps every vertex outside every collider (plus the contact thickness),
-// but a triangle is more than its corners. Where a body is thinner than the cloth's triangles —
-// a capsule of 2 cm radius or a 2 cm plank under edges of 3–5 cm — the body passes between the
-// vertices through a face while every vertex stays outside. Measured: a 0.5 m cotton square of
-// 11 × 11 vertices dropped onto a rod of 2 cm radius, or onto a plank 2 cm square in section (a
-// box or a triangle mesh), fell straight through it (ColliderFaceContactsTest); in stress scene 7 (three sheets pushed
-// through a ring of capsules) the worst edges ran straight through a capsule of the ring, one end
-// inside the ring and one outside, with a face at the capsule's core in 33–44 of the 150 frames.
+// Design note ----------- Why: ColliderResponse keeps every vertex outside every collider (plus the
+// contact thickness), but a triangle is more than its corners. Where a body is thinner than the
+// cloth's triangles — a capsule of 2 cm radius or a 2 cm plank under edges of 3–5 cm — the body
+// passes between the vertices through a face while every vertex stays outside. Measured: a 0.5 m
+// cotton square of 11 × 11 vertices dropped onto a rod of 2 cm radius, or onto a plank 2 cm square
+// in section (a box or a triangle mesh), fell straight through it (ColliderFaceContactsTest); in
+// stress scene 7 (three sheets pushed through a ring of capsules) the worst edges ran straight
+// through a capsule of the ring, one end inside the ring and one outside, with a face at the
+// capsule's core in 33–44 of the 150 frames.
 //
-// What: each body is reduced to cores, segments in its frame that faces keep a reach away from:
-// a sphere's centre (a segment of length 0) and a capsule's axis, reach = radius − allowance; a
-// box's twelve edges and a mesh's edges near the face (found in its tree per face), reach =
-// allowance / 2 (a flat face of a body cannot pass between the vertices; its edges can). Cloth passes the contact thickness as the allowance. Why an allowance
-// for round bodies: the vertices keep the thickness outside, and a coarse mesh over a curved body
-// sags between them by l² / (8 R) (3.8 mm for 5 cm edges on the 8 cm pusher of stress scene 7);
-// pushing those faces out would lift the vertices off wherever a coarse mesh lies on a curved
-// body and change ordinary draping for nothing, while a face that a thin body passes through is
-// caught long before the core. With it the curtain has no face contact at all (its state hash is
-// unchanged). Why half of it for box edges: a face resting on a box's flat face is a thickness
-// from its edges; half keeps it on its side of an edge it bends round, with room to tell the side
-// at the next step.
+// What: each body is reduced to cores, segments in its frame that faces keep a reach away from: a
+// sphere's centre (a segment of length 0) and a capsule's axis, reach = radius − allowance (at
+// least allowance / 2, for a body thinner than that); a box's twelve edges and a mesh's edges near
+// the face (found in its tree per face), reach = allowance / 2 (a flat face of a body cannot pass
+// between the vertices; its edges can). Cloth passes the contact thickness as the allowance. Why an
+// allowance for round bodies: the vertices keep the thickness outside, and a coarse mesh over a
+// curved body sags between them by l² / (8 R) (3.8 mm for 5 cm edges on the 8 cm pusher of stress
+// scene 7); pushing those faces out would lift the vertices off wherever a coarse mesh lies on a
+// curved body and change ordinary draping for nothing, while a face that a thin body passes through
+// is caught long before the core. With it the curtain has no face contact at all (its state hash is
+// unchanged). Why half of it for box edges: a face resting on a box's flat face is a thickness from
+// its edges; half keeps it on its side of an edge it bends round, with room to tell the side at the
+// next step.
 //
 // Contact points of a face and a core (facePoints), in the body's frame: over the face's interior,
 // the part of the core inside the triangle's prism is a line whose height over the face is
@@ -56,9 +56,9 @@
 // cloth round the body instead of pulling the face back into it (on the rod of the test, max
 // strain 0.101 with the holds, 0.103 without).
 //
-// Not covered: a mesh's vertices poking into a face without an edge crossing it (a spike
-// narrower than the triangles), friction on face contacts (the vertex pass takes it), and a face inside a body at
-// both ends of a step with no side to return to.
+// Not covered: a mesh's vertices poking into a face without an edge crossing it (a spike narrower
+// than the triangles), friction on face contacts (the vertex pass takes it), and a face inside a
+// body at both ends of a step with no side to return to.
 #pragma once
 
 #include "ColliderResponse.h"

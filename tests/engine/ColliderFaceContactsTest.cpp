@@ -212,9 +212,8 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
           if (gap.distance == 0) result.deepestFace = std::max(result.deepestFace, kRadius);
         }
       } else {
-        const Real gap =
-            closestPointsOnSegmentAndTriangle(Vec3(0.013, 0.38, -0.5), Vec3(0.013, 0.38, 0.5), a, b, c)
-                .distance;
+        const Vec3 axisStart(0.013, 0.38, -0.5), axisEnd(0.013, 0.38, 0.5);
+        const Real gap = closestPointsOnSegmentAndTriangle(axisStart, axisEnd, a, b, c).distance;
         result.deepestFace = std::max(result.deepestFace, kRadius - gap);
       }
     }
@@ -222,7 +221,9 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
   result.stateHash = world.stateHash();
   const std::span<const Vec3> x = world.positions(cloth).value();
   result.middleLowest = std::numeric_limits<Real>::infinity();
-  for (Index row = 0; row < n; ++row) result.middleLowest = std::min(result.middleLowest, x[row * n + n / 2].y());
+  for (Index row = 0; row < n; ++row) {
+    result.middleLowest = std::min(result.middleLowest, x[row * n + n / 2].y());
+  }
   return result;
 }
 
