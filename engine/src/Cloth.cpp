@@ -810,7 +810,9 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
           m_settings.material.thickness, m_pinnedMask, m_positions, m_velocities,
           m_strainLimiter ? &m_contactHolds : nullptr);
       report.contacts = contact.contacts;
-      contacts = contact.contacts + resolveFaceContacts();
+      const Index faceContacts = resolveFaceContacts();
+      report.faceContacts += faceContacts;
+      contacts = contact.contacts + faceContacts;
     } else {
       m_faceContacts.clear();
     }

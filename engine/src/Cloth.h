@@ -47,6 +47,7 @@ struct ClothFrameReport {
   bool teleported = false;  ///< carried with its pins' jump (SolverSettings::pinTeleportDistance)
   SelfCollisionReport selfCollision;  ///< summed over substeps
   Index contacts = 0;  ///< vertices touching colliders at the end of the frame
+  Index faceContacts = 0;  ///< faces pushed out of colliders (first pass of each substep)
   IntegratorReport integrator;
   /// Strain-limiter iterations and edges left over the limit, summed over the substeps of the
   /// frame's last attempt.

@@ -455,6 +455,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.strainLimitEdgesOver += report.strainLimit.edgesOverLimit;
     totalSubsteps += report.substeps;
     stats.contacts += report.contacts;
+    stats.faceContacts += report.faceContacts;
     stats.selfContacts += report.selfCollision.proximityContacts;
     stats.selfImpacts += report.selfCollision.impacts;
     stats.impactZones += report.selfCollision.impactZones;

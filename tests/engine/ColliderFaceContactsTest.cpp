@@ -153,6 +153,7 @@ struct RodDrop {
   Real deepestFace = 0;    // m into the rod (negative: outside)
   Real maxStrain = 0;
   std::uint64_t stateHash = 0;  // World::stateHash() at the end
+  Index faceContacts = 0;       // StepStats::faceContacts, summed over the frames
 };
 enum class Support { Rod, Plank, MeshPlank };
 
@@ -198,6 +199,7 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
   for (int frame = 0; frame < frames; ++frame) {
     EXPECT_EQ(world.step(1.0 / 60), StepStatus::Ok);
     result.maxStrain = std::max(result.maxStrain, world.stats().maxStrain);
+    result.faceContacts += world.stats().faceContacts;
     const std::span<const Vec3> x = world.positions(cloth).value();
     for (const TriangleRest& t : model->triangles()) {
       const Vec3& a = x[t.vertices[0]];
@@ -231,6 +233,7 @@ TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
   const RodDrop faces = dropOnRod(true, 40);
   // On the rod: the middle column is at the rod's top (0.40 m, plus the thickness), not below it.
   EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the rod";
+  EXPECT_GT(faces.faceContacts, 0) << "StepStats::faceContacts did not count them";
   // No face went more than the allowance (the cloth's 3 mm thickness) into the rod.
   EXPECT_LT(faces.deepestFace, 0.003 + 1e-6);
   EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
@@ -239,6 +242,7 @@ TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
   // sheet falls through.
   const RodDrop vertices = dropOnRod(false, 40);
   EXPECT_LT(vertices.middleLowest, 0.2) << "the rod no longer passes through the faces";
+  EXPECT_EQ(vertices.faceContacts, 0);
   EXPECT_GT(vertices.deepestFace, 0.01);
 }
 

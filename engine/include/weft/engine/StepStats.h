@@ -77,6 +77,9 @@ struct StepStats {
   Real potentialEnergy = 0;
   Real maxSpeed = 0;           ///< m/s, fastest vertex at the end
   Index contacts = 0;          ///< cloth vertices touching a collider at the end
+  /// Cloth faces a collider had passed into between their vertices, pushed back out
+  /// (ColliderFaceContacts; first collision pass of every substep, summed)
+  Index faceContacts = 0;
   Index selfContacts = 0;      ///< self-proximity pairs repelled (all substeps)
   Index selfImpacts = 0;       ///< swept self-collisions resolved by impulses (all substeps)
   Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
