@@ -156,22 +156,33 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
   // the lowest (lo, hi) of their triangles that share no vertex. The broad phase reports that
   // pair whenever it reports any (its boxes hold the features' boxes; margin ≤ 2 × inflate), so
   // nothing is lost.
-  auto vertexOwner = [&](Index vertex, Index triangle) {
+  //
+  // Both tests below ask only whether the pair at hand is the canonical one, so they stop at the
+  // first candidate that beats it and test the cheap order before the vertex sharing: the same
+  // answers as finding the canonical pair and comparing, for less work (most of this stage's).
+  auto isVertexOwner = [&](Index vertex, Index owner, Index triangle) {
+    // The triangles around the vertex are ascending: `owner` is the lowest that shares no
+    // vertex with `triangle` when it shares none and every one before it shares one.
     for (Index k = m_vertexTriangleBegin[vertex]; k < m_vertexTriangleBegin[vertex + 1]; ++k) {
-      if (!sharesVertex(m_vertexTriangles[k], triangle)) return m_vertexTriangles[k];
+      const Index candidate = m_vertexTriangles[k];
+      if (candidate == owner) return !sharesVertex(candidate, triangle);
+      if (!sharesVertex(candidate, triangle)) return false;
     }
-    return kInvalidIndex;
+    return false;
   };
-  auto edgeOwner = [&](Index a, Index b) {
-    TrianglePair best{kInvalidIndex, kInvalidIndex};
+  auto isEdgeOwner = [&](Index a, Index b, const TrianglePair& pair) {
+    // `pair` (a triangle of each edge) is the canonical pair when it is one of the edges' pairs
+    // of triangles, shares no vertex, and no other of those that shares none orders before it.
+    bool listed = false;
     for (Index ta : m_edgeTriangles[a]) {
       for (Index tb : m_edgeTriangles[b]) {
-        if (ta == kInvalidIndex || tb == kInvalidIndex || sharesVertex(ta, tb)) continue;
-        const TrianglePair pair{std::min(ta, tb), std::max(ta, tb)};
-        if (pair < best) best = pair;
+        if (ta == kInvalidIndex || tb == kInvalidIndex) continue;
+        const TrianglePair candidate{std::min(ta, tb), std::max(ta, tb)};
+        if (candidate < pair && !sharesVertex(ta, tb)) return false;
+        listed = listed || candidate == pair;
       }
     }
-    return best;
+    return listed && !sharesVertex(pair.first, pair.second);
   };
   auto touchesDirty = [&](Index vertex, const std::array<Index, 3>& triangle) {
     return !dirty || (*dirty)[vertex] || (*dirty)[triangle[0]] || (*dirty)[triangle[1]] ||
@@ -186,29 +197,34 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
       for (Index vertex : m_triangles[pair.first]) {
         Aabb box = m_vertexBoxes[vertex];
         box.inflate(margin);
-        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first &&
-            touchesDirty(vertex, m_triangles[pair.second])) {
+        if (box.overlaps(secondBox) && touchesDirty(vertex, m_triangles[pair.second]) &&
+            isVertexOwner(vertex, pair.first, pair.second)) {
           vertexTriangle.push_back({vertex, pair.second});
         }
       }
       for (Index vertex : m_triangles[pair.second]) {
         Aabb box = m_vertexBoxes[vertex];
         box.inflate(margin);
-        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second &&
-            touchesDirty(vertex, m_triangles[pair.first])) {
+        if (box.overlaps(firstBox) && touchesDirty(vertex, m_triangles[pair.first]) &&
+            isVertexOwner(vertex, pair.second, pair.first)) {
           vertexTriangle.push_back({vertex, pair.first});
         }
       }
       // The broad phase reports only triangles that share no vertex, so their edges share none
-      // either.
+      // either. The second triangle's edge boxes are made once, not once per edge of the first.
+      const std::array<Index, 3>& secondEdges = m_triangleEdges[pair.second];
+      const std::array<Aabb, 3> secondEdgeBoxes{edgeBox(secondEdges[0]), edgeBox(secondEdges[1]),
+                                                edgeBox(secondEdges[2])};
       for (Index a : m_triangleEdges[pair.first]) {
         Aabb first = edgeBox(a);
         first.inflate(margin);
         if (!first.overlaps(secondBox)) continue;
-        for (Index b : m_triangleEdges[pair.second]) {
-          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair &&
+        for (int j = 0; j < 3; ++j) {
+          const Index b = secondEdges[j];
+          if (first.overlaps(secondEdgeBoxes[j]) &&
               (!dirty || (*dirty)[m_edges[a][0]] || (*dirty)[m_edges[a][1]] ||
-               (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]])) {
+               (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]]) &&
+              isEdgeOwner(a, b, pair)) {
             edgeEdge.push_back({std::min(a, b), std::max(a, b)});
           }
         }
