@@ -105,13 +105,13 @@ void ContactResolver::pairParameters(Index first, Index second, Real& thickness,
   }
 }
 
-bool ContactResolver::sharesVertex(Index first, Index second) const {
+inline bool ContactResolver::sharesVertex(Index first, Index second) const {
   const std::array<Index, 3>& a = m_triangles[first];
   const std::array<Index, 3>& b = m_triangles[second];
-  for (Index i : a) {
-    if (i == b[0] || i == b[1] || i == b[2]) return true;
-  }
-  return false;
+  // All nine comparisons without branches: collectFeaturePairs asks this millions of times per
+  // second with answers a branch predictor cannot guess.
+  return ((a[0] == b[0]) | (a[0] == b[1]) | (a[0] == b[2]) | (a[1] == b[0]) | (a[1] == b[1]) |
+          (a[1] == b[2]) | (a[2] == b[0]) | (a[2] == b[1]) | (a[2] == b[2])) != 0;
 }
 
 void ContactResolver::findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to,
@@ -194,22 +194,38 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
       const TrianglePair& pair = m_trianglePairs[k];
       const Aabb firstBox = triangleBox(pair.first);
       const Aabb secondBox = triangleBox(pair.second);
-      for (Index vertex : m_triangles[pair.first]) {
-        Aabb box = m_vertexBoxes[vertex];
-        box.inflate(margin);
-        if (box.overlaps(secondBox) && touchesDirty(vertex, m_triangles[pair.second]) &&
-            isVertexOwner(vertex, pair.first, pair.second)) {
-          vertexTriangle.push_back({vertex, pair.second});
+      // Every vertex and edge box of a triangle lies in its box, and rounding is monotone, so
+      // each one inflated by the margin lies in the triangle's box inflated by it: when that
+      // misses the other triangle's box, so does every test of that side below. (The broad
+      // phase inflates both boxes, and its trees refit loosely, so this drops many pairs.)
+      Aabb firstReach = firstBox;
+      firstReach.inflate(margin);
+      Aabb secondReach = secondBox;
+      secondReach.inflate(margin);
+      const bool firstReaches = firstReach.overlaps(secondBox);
+      const bool secondReaches = secondReach.overlaps(firstBox);
+      if (!firstReaches && !secondReaches) continue;
+      if (firstReaches) {
+        for (Index vertex : m_triangles[pair.first]) {
+          Aabb box = m_vertexBoxes[vertex];
+          box.inflate(margin);
+          if (box.overlaps(secondBox) && touchesDirty(vertex, m_triangles[pair.second]) &&
+              isVertexOwner(vertex, pair.first, pair.second)) {
+            vertexTriangle.push_back({vertex, pair.second});
+          }
         }
       }
-      for (Index vertex : m_triangles[pair.second]) {
-        Aabb box = m_vertexBoxes[vertex];
-        box.inflate(margin);
-        if (box.overlaps(firstBox) && touchesDirty(vertex, m_triangles[pair.first]) &&
-            isVertexOwner(vertex, pair.second, pair.first)) {
-          vertexTriangle.push_back({vertex, pair.first});
+      if (secondReaches) {
+        for (Index vertex : m_triangles[pair.second]) {
+          Aabb box = m_vertexBoxes[vertex];
+          box.inflate(margin);
+          if (box.overlaps(firstBox) && touchesDirty(vertex, m_triangles[pair.first]) &&
+              isVertexOwner(vertex, pair.second, pair.first)) {
+            vertexTriangle.push_back({vertex, pair.first});
+          }
         }
       }
+      if (!firstReaches) continue;
       // The broad phase reports only triangles that share no vertex, so their edges share none
       // either. The second triangle's edge boxes are made once, not once per edge of the first.
       const std::array<Index, 3>& secondEdges = m_triangleEdges[pair.second];

@@ -204,7 +204,7 @@ class ContactResolver {
   // With `dirty` (per vertex), only the feature pairs with a dirty vertex.
   void collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin,
                            const std::vector<char>* dirty = nullptr);
-  bool sharesVertex(Index firstTriangle, Index secondTriangle) const;
+  inline bool sharesVertex(Index firstTriangle, Index secondTriangle) const;
   // Runs test(pairIndex, contact) -> bool over every feature pair (vertex–triangle first, then
   // edge–edge) in parallel and leaves the contacts it accepted in m_contacts, in pair order.
   template <class Test>
