@@ -137,18 +137,35 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
   } else {
     boxVertices(0, vertexCount, 0);
   }
-  auto triangleBox = [&](Index triangle) {
-    const std::array<Index, 3>& c = m_triangles[triangle];
-    Aabb box = m_vertexBoxes[c[0]];
-    box.expand(m_vertexBoxes[c[1]]);
-    box.expand(m_vertexBoxes[c[2]]);
-    return box;
+  // Likewise every triangle's and edge's box (the same min and max, so the same bits): a
+  // triangle is in a few candidate pairs, an edge's box is asked for by each of them.
+  const Index triangleCount = Index(m_triangles.size());
+  const Index edgeCount = Index(m_edges.size());
+  m_triangleBoxes.resize(triangleCount);
+  m_edgeBoxes.resize(edgeCount);
+  auto boxFeatures = [&](Index begin, Index end, int) {
+    for (Index i = begin; i < end; ++i) {
+      if (i < triangleCount) {
+        const std::array<Index, 3>& c = m_triangles[i];
+        Aabb box = m_vertexBoxes[c[0]];
+        box.expand(m_vertexBoxes[c[1]]);
+        box.expand(m_vertexBoxes[c[2]]);
+        m_triangleBoxes[i] = box;
+      } else {
+        const std::array<Index, 2>& c = m_edges[i - triangleCount];
+        Aabb box = m_vertexBoxes[c[0]];
+        box.expand(m_vertexBoxes[c[1]]);
+        m_edgeBoxes[i - triangleCount] = box;
+      }
+    }
   };
-  auto edgeBox = [&](Index edge) {
-    Aabb box = m_vertexBoxes[m_edges[edge][0]];
-    box.expand(m_vertexBoxes[m_edges[edge][1]]);
-    return box;
-  };
+  if (m_tasks) {
+    m_tasks->parallelFor(triangleCount + edgeCount, kGrainVertices, boxFeatures);
+  } else {
+    boxFeatures(0, triangleCount + edgeCount, 0);
+  }
+  auto triangleBox = [&](Index triangle) -> const Aabb& { return m_triangleBoxes[triangle]; };
+  auto edgeBox = [&](Index edge) -> const Aabb& { return m_edgeBoxes[edge]; };
   // A feature pair is reached through several triangle pairs; it is taken from one of them
   // only, its canonical pair, so no sort is needed to remove the others and the features come
   // out in the (sorted) order of the triangle pairs. Vertex v against triangle B: from the
@@ -192,8 +209,8 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
                      std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
       const TrianglePair& pair = m_trianglePairs[k];
-      const Aabb firstBox = triangleBox(pair.first);
-      const Aabb secondBox = triangleBox(pair.second);
+      const Aabb& firstBox = triangleBox(pair.first);
+      const Aabb& secondBox = triangleBox(pair.second);
       // Every vertex and edge box of a triangle lies in its box, and rounding is monotone, so
       // each one inflated by the margin lies in the triangle's box inflated by it: when that
       // misses the other triangle's box, so does every test of that side below. (The broad
@@ -227,17 +244,15 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
       }
       if (!firstReaches) continue;
       // The broad phase reports only triangles that share no vertex, so their edges share none
-      // either. The second triangle's edge boxes are made once, not once per edge of the first.
+      // either.
       const std::array<Index, 3>& secondEdges = m_triangleEdges[pair.second];
-      const std::array<Aabb, 3> secondEdgeBoxes{edgeBox(secondEdges[0]), edgeBox(secondEdges[1]),
-                                                edgeBox(secondEdges[2])};
       for (Index a : m_triangleEdges[pair.first]) {
         Aabb first = edgeBox(a);
         first.inflate(margin);
         if (!first.overlaps(secondBox)) continue;
         for (int j = 0; j < 3; ++j) {
           const Index b = secondEdges[j];
-          if (first.overlaps(secondEdgeBoxes[j]) &&
+          if (first.overlaps(edgeBox(b)) &&
               (!dirty || (*dirty)[m_edges[a][0]] || (*dirty)[m_edges[a][1]] ||
                (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]]) &&
               isEdgeOwner(a, b, pair)) {

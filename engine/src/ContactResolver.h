@@ -240,6 +240,7 @@ class ContactResolver {
   std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
   std::vector<std::array<Index, 2>> m_edgeTriangles;  // triangles of each edge (kInvalidIndex: none)
   std::vector<Aabb> m_vertexBoxes;                    // each vertex's box over the step
+  std::vector<Aabb> m_triangleBoxes, m_edgeBoxes;     // each triangle's and edge's, likewise
   struct BlockFeatures {
     std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
   };
