@@ -177,19 +177,21 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
   // Both tests below ask only whether the pair at hand is the canonical one, so they stop at the
   // first candidate that beats it and test the cheap order before the vertex sharing: the same
   // answers as finding the canonical pair and comparing, for less work (most of this stage's).
+  // A pair whose triangles share a vertex is canonical for nothing; collect() skips it, so both
+  // tests are asked only about pairs that share none.
   auto isVertexOwner = [&](Index vertex, Index owner, Index triangle) {
-    // The triangles around the vertex are ascending: `owner` is the lowest that shares no
-    // vertex with `triangle` when it shares none and every one before it shares one.
+    // The triangles around the vertex are ascending: `owner` (sharing no vertex with
+    // `triangle`) is the lowest that shares none when every one before it shares one.
     for (Index k = m_vertexTriangleBegin[vertex]; k < m_vertexTriangleBegin[vertex + 1]; ++k) {
       const Index candidate = m_vertexTriangles[k];
-      if (candidate == owner) return !sharesVertex(candidate, triangle);
+      if (candidate == owner) return true;
       if (!sharesVertex(candidate, triangle)) return false;
     }
     return false;
   };
   auto isEdgeOwner = [&](Index a, Index b, const TrianglePair& pair) {
-    // `pair` (a triangle of each edge) is the canonical pair when it is one of the edges' pairs
-    // of triangles, shares no vertex, and no other of those that shares none orders before it.
+    // `pair` (a triangle of each edge, sharing no vertex) is the canonical pair when it is one
+    // of the edges' pairs of triangles and no other of those that shares none orders before it.
     bool listed = false;
     for (Index ta : m_edgeTriangles[a]) {
       for (Index tb : m_edgeTriangles[b]) {
@@ -199,7 +201,7 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
         listed = listed || candidate == pair;
       }
     }
-    return listed && !sharesVertex(pair.first, pair.second);
+    return listed;
   };
   auto touchesDirty = [&](Index vertex, const std::array<Index, 3>& triangle) {
     return !dirty || (*dirty)[vertex] || (*dirty)[triangle[0]] || (*dirty)[triangle[1]] ||
@@ -209,6 +211,7 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
                      std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
       const TrianglePair& pair = m_trianglePairs[k];
+      if (sharesVertex(pair.first, pair.second)) continue;  // none from the broad phase
       const Aabb& firstBox = triangleBox(pair.first);
       const Aabb& secondBox = triangleBox(pair.second);
       // Every vertex and edge box of a triangle lies in its box, and rounding is monotone, so
