@@ -236,16 +236,16 @@ void Bvh::refitNodes(TaskSystem* tasks) {
   m_lastRefit.skippedNodes = Index(m_nodes.size()) - recomputed;
 }
 
-bool Bvh::slotsShareVertex(Index slotA, Index slotB) const {
+inline bool Bvh::slotsShareVertex(Index slotA, Index slotB) const {
   const std::array<Index, 3>& x = m_slotTriangles[slotA];
   const std::array<Index, 3>& y = m_slotTriangles[slotB];
-  for (Index i : x) {
-    if (i == y[0] || i == y[1] || i == y[2]) return true;
-  }
-  return false;
+  // All nine comparisons without branches: asked for every pair of overlapping leaf boxes, with
+  // answers a branch predictor cannot guess.
+  return ((x[0] == y[0]) | (x[0] == y[1]) | (x[0] == y[2]) | (x[1] == y[0]) | (x[1] == y[1]) |
+          (x[1] == y[2]) | (x[2] == y[0]) | (x[2] == y[1]) | (x[2] == y[2])) != 0;
 }
 
-void Bvh::addSlotPair(Index slotA, Index slotB, std::vector<TrianglePair>& pairs) const {
+inline void Bvh::addSlotPair(Index slotA, Index slotB, std::vector<TrianglePair>& pairs) const {
   if (!m_slotBounds[slotA].overlaps(m_slotBounds[slotB]) || slotsShareVertex(slotA, slotB)) return;
   const Index a = m_triangleOrder[slotA];
   const Index b = m_triangleOrder[slotB];

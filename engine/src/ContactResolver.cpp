@@ -105,13 +105,13 @@ void ContactResolver::pairParameters(Index first, Index second, Real& thickness,
   }
 }
 
-bool ContactResolver::sharesVertex(Index first, Index second) const {
+inline bool ContactResolver::sharesVertex(Index first, Index second) const {
   const std::array<Index, 3>& a = m_triangles[first];
   const std::array<Index, 3>& b = m_triangles[second];
-  for (Index i : a) {
-    if (i == b[0] || i == b[1] || i == b[2]) return true;
-  }
-  return false;
+  // All nine comparisons without branches: collectFeaturePairs asks this millions of times per
+  // second with answers a branch predictor cannot guess.
+  return ((a[0] == b[0]) | (a[0] == b[1]) | (a[0] == b[2]) | (a[1] == b[0]) | (a[1] == b[1]) |
+          (a[1] == b[2]) | (a[2] == b[0]) | (a[2] == b[1]) | (a[2] == b[2])) != 0;
 }
 
 void ContactResolver::findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to,
@@ -137,18 +137,35 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
   } else {
     boxVertices(0, vertexCount, 0);
   }
-  auto triangleBox = [&](Index triangle) {
-    const std::array<Index, 3>& c = m_triangles[triangle];
-    Aabb box = m_vertexBoxes[c[0]];
-    box.expand(m_vertexBoxes[c[1]]);
-    box.expand(m_vertexBoxes[c[2]]);
-    return box;
+  // Likewise every triangle's and edge's box (the same min and max, so the same bits): a
+  // triangle is in a few candidate pairs, an edge's box is asked for by each of them.
+  const Index triangleCount = Index(m_triangles.size());
+  const Index edgeCount = Index(m_edges.size());
+  m_triangleBoxes.resize(triangleCount);
+  m_edgeBoxes.resize(edgeCount);
+  auto boxFeatures = [&](Index begin, Index end, int) {
+    for (Index i = begin; i < end; ++i) {
+      if (i < triangleCount) {
+        const std::array<Index, 3>& c = m_triangles[i];
+        Aabb box = m_vertexBoxes[c[0]];
+        box.expand(m_vertexBoxes[c[1]]);
+        box.expand(m_vertexBoxes[c[2]]);
+        m_triangleBoxes[i] = box;
+      } else {
+        const std::array<Index, 2>& c = m_edges[i - triangleCount];
+        Aabb box = m_vertexBoxes[c[0]];
+        box.expand(m_vertexBoxes[c[1]]);
+        m_edgeBoxes[i - triangleCount] = box;
+      }
+    }
   };
-  auto edgeBox = [&](Index edge) {
-    Aabb box = m_vertexBoxes[m_edges[edge][0]];
-    box.expand(m_vertexBoxes[m_edges[edge][1]]);
-    return box;
-  };
+  if (m_tasks) {
+    m_tasks->parallelFor(triangleCount + edgeCount, kGrainVertices, boxFeatures);
+  } else {
+    boxFeatures(0, triangleCount + edgeCount, 0);
+  }
+  auto triangleBox = [&](Index triangle) -> const Aabb& { return m_triangleBoxes[triangle]; };
+  auto edgeBox = [&](Index edge) -> const Aabb& { return m_edgeBoxes[edge]; };
   // A feature pair is reached through several triangle pairs; it is taken from one of them
   // only, its canonical pair, so no sort is needed to remove the others and the features come
   // out in the (sorted) order of the triangle pairs. Vertex v against triangle B: from the
@@ -156,22 +173,35 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
   // the lowest (lo, hi) of their triangles that share no vertex. The broad phase reports that
   // pair whenever it reports any (its boxes hold the features' boxes; margin ≤ 2 × inflate), so
   // nothing is lost.
-  auto vertexOwner = [&](Index vertex, Index triangle) {
+  //
+  // Both tests below ask only whether the pair at hand is the canonical one, so they stop at the
+  // first candidate that beats it and test the cheap order before the vertex sharing: the same
+  // answers as finding the canonical pair and comparing, for less work (most of this stage's).
+  // A pair whose triangles share a vertex is canonical for nothing; collect() skips it, so both
+  // tests are asked only about pairs that share none.
+  auto isVertexOwner = [&](Index vertex, Index owner, Index triangle) {
+    // The triangles around the vertex are ascending: `owner` (sharing no vertex with
+    // `triangle`) is the lowest that shares none when every one before it shares one.
     for (Index k = m_vertexTriangleBegin[vertex]; k < m_vertexTriangleBegin[vertex + 1]; ++k) {
-      if (!sharesVertex(m_vertexTriangles[k], triangle)) return m_vertexTriangles[k];
+      const Index candidate = m_vertexTriangles[k];
+      if (candidate == owner) return true;
+      if (!sharesVertex(candidate, triangle)) return false;
     }
-    return kInvalidIndex;
+    return false;
   };
-  auto edgeOwner = [&](Index a, Index b) {
-    TrianglePair best{kInvalidIndex, kInvalidIndex};
+  auto isEdgeOwner = [&](Index a, Index b, const TrianglePair& pair) {
+    // `pair` (a triangle of each edge, sharing no vertex) is the canonical pair when it is one
+    // of the edges' pairs of triangles and no other of those that shares none orders before it.
+    bool listed = false;
     for (Index ta : m_edgeTriangles[a]) {
       for (Index tb : m_edgeTriangles[b]) {
-        if (ta == kInvalidIndex || tb == kInvalidIndex || sharesVertex(ta, tb)) continue;
-        const TrianglePair pair{std::min(ta, tb), std::max(ta, tb)};
-        if (pair < best) best = pair;
+        if (ta == kInvalidIndex || tb == kInvalidIndex) continue;
+        const TrianglePair candidate{std::min(ta, tb), std::max(ta, tb)};
+        if (candidate < pair && !sharesVertex(ta, tb)) return false;
+        listed = listed || candidate == pair;
       }
     }
-    return best;
+    return listed;
   };
   auto touchesDirty = [&](Index vertex, const std::array<Index, 3>& triangle) {
     return !dirty || (*dirty)[vertex] || (*dirty)[triangle[0]] || (*dirty)[triangle[1]] ||
@@ -181,34 +211,54 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
                      std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
       const TrianglePair& pair = m_trianglePairs[k];
-      const Aabb firstBox = triangleBox(pair.first);
-      const Aabb secondBox = triangleBox(pair.second);
-      for (Index vertex : m_triangles[pair.first]) {
-        Aabb box = m_vertexBoxes[vertex];
-        box.inflate(margin);
-        if (box.overlaps(secondBox) && vertexOwner(vertex, pair.second) == pair.first &&
-            touchesDirty(vertex, m_triangles[pair.second])) {
-          vertexTriangle.push_back({vertex, pair.second});
+      if (sharesVertex(pair.first, pair.second)) continue;  // none from the broad phase
+      const Aabb& firstBox = triangleBox(pair.first);
+      const Aabb& secondBox = triangleBox(pair.second);
+      // Every vertex and edge box of a triangle lies in its box, and rounding is monotone, so
+      // each one inflated by the margin lies in the triangle's box inflated by it: when that
+      // misses the other triangle's box, so does every test of that side below. (The broad
+      // phase inflates both boxes and refits loosely: about one curtain pair in eight drops.)
+      Aabb firstReach = firstBox;
+      firstReach.inflate(margin);
+      Aabb secondReach = secondBox;
+      secondReach.inflate(margin);
+      const bool firstReaches = firstReach.overlaps(secondBox);
+      const bool secondReaches = secondReach.overlaps(firstBox);
+      if (!firstReaches && !secondReaches) continue;
+      if (firstReaches) {
+        for (Index vertex : m_triangles[pair.first]) {
+          Aabb box = m_vertexBoxes[vertex];
+          box.inflate(margin);
+          if (box.overlaps(secondBox) && touchesDirty(vertex, m_triangles[pair.second]) &&
+              isVertexOwner(vertex, pair.first, pair.second)) {
+            vertexTriangle.push_back({vertex, pair.second});
+          }
         }
       }
-      for (Index vertex : m_triangles[pair.second]) {
-        Aabb box = m_vertexBoxes[vertex];
-        box.inflate(margin);
-        if (box.overlaps(firstBox) && vertexOwner(vertex, pair.first) == pair.second &&
-            touchesDirty(vertex, m_triangles[pair.first])) {
-          vertexTriangle.push_back({vertex, pair.first});
+      if (secondReaches) {
+        for (Index vertex : m_triangles[pair.second]) {
+          Aabb box = m_vertexBoxes[vertex];
+          box.inflate(margin);
+          if (box.overlaps(firstBox) && touchesDirty(vertex, m_triangles[pair.first]) &&
+              isVertexOwner(vertex, pair.second, pair.first)) {
+            vertexTriangle.push_back({vertex, pair.first});
+          }
         }
       }
+      if (!firstReaches) continue;
       // The broad phase reports only triangles that share no vertex, so their edges share none
       // either.
+      const std::array<Index, 3>& secondEdges = m_triangleEdges[pair.second];
       for (Index a : m_triangleEdges[pair.first]) {
         Aabb first = edgeBox(a);
         first.inflate(margin);
         if (!first.overlaps(secondBox)) continue;
-        for (Index b : m_triangleEdges[pair.second]) {
-          if (first.overlaps(edgeBox(b)) && edgeOwner(a, b) == pair &&
+        for (int j = 0; j < 3; ++j) {
+          const Index b = secondEdges[j];
+          if (first.overlaps(edgeBox(b)) &&
               (!dirty || (*dirty)[m_edges[a][0]] || (*dirty)[m_edges[a][1]] ||
-               (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]])) {
+               (*dirty)[m_edges[b][0]] || (*dirty)[m_edges[b][1]]) &&
+              isEdgeOwner(a, b, pair)) {
             edgeEdge.push_back({std::min(a, b), std::max(a, b)});
           }
         }

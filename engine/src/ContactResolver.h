@@ -204,7 +204,7 @@ class ContactResolver {
   // With `dirty` (per vertex), only the feature pairs with a dirty vertex.
   void collectFeaturePairs(const Vec3Array& from, const Vec3Array& to, Real margin,
                            const std::vector<char>* dirty = nullptr);
-  bool sharesVertex(Index firstTriangle, Index secondTriangle) const;
+  inline bool sharesVertex(Index firstTriangle, Index secondTriangle) const;
   // Runs test(pairIndex, contact) -> bool over every feature pair (vertex–triangle first, then
   // edge–edge) in parallel and leaves the contacts it accepted in m_contacts, in pair order.
   template <class Test>
@@ -240,6 +240,7 @@ class ContactResolver {
   std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
   std::vector<std::array<Index, 2>> m_edgeTriangles;  // triangles of each edge (kInvalidIndex: none)
   std::vector<Aabb> m_vertexBoxes;                    // each vertex's box over the step
+  std::vector<Aabb> m_triangleBoxes, m_edgeBoxes;     // each triangle's and edge's, likewise
   struct BlockFeatures {
     std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
   };
