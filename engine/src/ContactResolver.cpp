@@ -225,26 +225,19 @@ void ContactResolver::collectFeaturePairs(const Vec3Array& from, const Vec3Array
       const bool firstReaches = firstReach.overlaps(secondBox);
       const bool secondReaches = secondReach.overlaps(firstBox);
       if (!firstReaches && !secondReaches) continue;
-      if (firstReaches) {
-        for (Index vertex : m_triangles[pair.first]) {
+      // The vertices of triangle `from` that reach triangle `to` (box `toBox`) and own the pair.
+      const auto addVertexContacts = [&](Index from, Index to, const Aabb& toBox) {
+        for (Index vertex : m_triangles[from]) {
           Aabb box = m_vertexBoxes[vertex];
           box.inflate(margin);
-          if (box.overlaps(secondBox) && touchesDirty(vertex, m_triangles[pair.second]) &&
-              isVertexOwner(vertex, pair.first, pair.second)) {
-            vertexTriangle.push_back({vertex, pair.second});
+          if (box.overlaps(toBox) && touchesDirty(vertex, m_triangles[to]) &&
+              isVertexOwner(vertex, from, to)) {
+            vertexTriangle.push_back({vertex, to});
           }
         }
-      }
-      if (secondReaches) {
-        for (Index vertex : m_triangles[pair.second]) {
-          Aabb box = m_vertexBoxes[vertex];
-          box.inflate(margin);
-          if (box.overlaps(firstBox) && touchesDirty(vertex, m_triangles[pair.first]) &&
-              isVertexOwner(vertex, pair.second, pair.first)) {
-            vertexTriangle.push_back({vertex, pair.first});
-          }
-        }
-      }
+      };
+      if (firstReaches) addVertexContacts(pair.first, pair.second, secondBox);
+      if (secondReaches) addVertexContacts(pair.second, pair.first, firstBox);
       if (!firstReaches) continue;
       // The broad phase reports only triangles that share no vertex, so their edges share none
       // either.

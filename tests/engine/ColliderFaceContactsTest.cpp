@@ -247,24 +247,18 @@ TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
 }
 
 TEST(ColliderFaceContacts, ASheetHangsOnAPlankThinnerThanItsTriangles) {
-  // A box 2 cm square in section: its edges have no radius, so a face is in contact when one
+  // A box 2 cm square in section, and the same plank as a triangle mesh (its cores are the edges
+  // of its triangles near each face): edges have no radius, so a face is in contact when one
   // crossed it within the step, and goes back to where it came from.
-  const RodDrop faces = dropOnRod(true, 40, Support::Plank);
-  EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the plank";
-  EXPECT_EQ(faces.deepestFace, 0) << "a top edge of the plank crossed a face";
-  EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
-  const RodDrop vertices = dropOnRod(false, 40, Support::Plank);
-  EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
-}
-
-TEST(ColliderFaceContacts, ASheetHangsOnAMeshPlankThinnerThanItsTriangles) {
-  // The same plank as a triangle mesh: its cores are the edges of its triangles near each face.
-  const RodDrop faces = dropOnRod(true, 40, Support::MeshPlank);
-  EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the plank";
-  EXPECT_EQ(faces.deepestFace, 0) << "a top edge of the plank crossed a face";
-  EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
-  const RodDrop vertices = dropOnRod(false, 40, Support::MeshPlank);
-  EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
+  for (Support plank : {Support::Plank, Support::MeshPlank}) {
+    SCOPED_TRACE(plank == Support::Plank ? "box" : "mesh");
+    const RodDrop faces = dropOnRod(true, 40, plank);
+    EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the plank";
+    EXPECT_EQ(faces.deepestFace, 0) << "a top edge of the plank crossed a face";
+    EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
+    const RodDrop vertices = dropOnRod(false, 40, plank);
+    EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
+  }
 }
 
 TEST(ColliderFaceContacts, AreBitwiseTheSameOnOneAndTwoThreads) {
