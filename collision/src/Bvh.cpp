@@ -237,12 +237,7 @@ void Bvh::refitNodes(TaskSystem* tasks) {
 }
 
 inline bool Bvh::slotsShareVertex(Index slotA, Index slotB) const {
-  const std::array<Index, 3>& x = m_slotTriangles[slotA];
-  const std::array<Index, 3>& y = m_slotTriangles[slotB];
-  // All nine comparisons without branches: asked for every pair of overlapping leaf boxes, with
-  // answers a branch predictor cannot guess.
-  return ((x[0] == y[0]) | (x[0] == y[1]) | (x[0] == y[2]) | (x[1] == y[0]) | (x[1] == y[1]) |
-          (x[1] == y[2]) | (x[2] == y[0]) | (x[2] == y[1]) | (x[2] == y[2])) != 0;
+  return trianglesShareVertex(m_slotTriangles[slotA], m_slotTriangles[slotB]);
 }
 
 inline void Bvh::addSlotPair(Index slotA, Index slotB, std::vector<TrianglePair>& pairs) const {

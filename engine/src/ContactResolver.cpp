@@ -106,12 +106,7 @@ void ContactResolver::pairParameters(Index first, Index second, Real& thickness,
 }
 
 inline bool ContactResolver::sharesVertex(Index first, Index second) const {
-  const std::array<Index, 3>& a = m_triangles[first];
-  const std::array<Index, 3>& b = m_triangles[second];
-  // All nine comparisons without branches: collectFeaturePairs asks this millions of times per
-  // second with answers a branch predictor cannot guess.
-  return ((a[0] == b[0]) | (a[0] == b[1]) | (a[0] == b[2]) | (a[1] == b[0]) | (a[1] == b[1]) |
-          (a[1] == b[2]) | (a[2] == b[0]) | (a[2] == b[1]) | (a[2] == b[2])) != 0;
+  return trianglesShareVertex(m_triangles[first], m_triangles[second]);
 }
 
 void ContactResolver::findTrianglePairsTouching(const Vec3Array& from, const Vec3Array& to,

@@ -96,6 +96,14 @@ struct TrianglePair {
   friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
 };
 
+/// True when triangles `a` and `b` (vertex indices) have a vertex in common. All nine comparisons
+/// without branches: the broad phase and the self-collision's feature pairs ask it for every
+/// candidate pair, with answers a branch predictor cannot guess.
+inline bool trianglesShareVertex(const std::array<Index, 3>& a, const std::array<Index, 3>& b) {
+  return ((a[0] == b[0]) | (a[0] == b[1]) | (a[0] == b[2]) | (a[1] == b[0]) | (a[1] == b[1]) |
+          (a[1] == b[2]) | (a[2] == b[0]) | (a[2] == b[1]) | (a[2] == b[2])) != 0;
+}
+
 /// AABB tree over the triangles of one mesh (see the design note above).
 class Bvh {
  public:
