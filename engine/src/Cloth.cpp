@@ -676,17 +676,19 @@ Index Cloth::resolveFaceContacts() {
       m_faceContacts.resolve(m_nearColliders, m_model->triangles(), m_stepStartPositions,
                              m_inverseMasses, m_settings.material.thickness, m_positions,
                              m_velocities);
-  if (faces.contacts > 0) {
-    // Pushing a face out of one body can move its corners into another (a sheet pressed between
-    // a ring and a pusher): the vertices keep the last word. Without friction, which the first
-    // pass took; with the holds, so that a corner put on a surface is held there.
-    (void)m_colliderResponse.resolve(m_nearColliders, m_stepStartPositions,
-                                     m_stepStartVelocities, m_settings.material.thickness,
-                                     m_pinnedMask, m_positions, m_velocities,
-                                     m_strainLimiter ? &m_contactHolds : nullptr,
-                                     /*friction=*/false);
-  }
+  // Pushing a face out of one body can move its corners into another (a sheet pressed between
+  // a ring and a pusher): the vertices keep the last word.
+  if (faces.contacts > 0) keepVerticesOutOfColliders();
   return faces.contacts;
+}
+
+void Cloth::keepVerticesOutOfColliders() {
+  // Without friction, which the substep's first pass took; with the holds, so that a vertex put
+  // on a surface is held there.
+  (void)m_colliderResponse.resolve(m_nearColliders, m_stepStartPositions, m_stepStartVelocities,
+                                   m_settings.material.thickness, m_pinnedMask, m_positions,
+                                   m_velocities, m_strainLimiter ? &m_contactHolds : nullptr,
+                                   /*friction=*/false);
 }
 
 void Cloth::selectResponseColliders(std::span<const ColliderFrame> colliders) {
@@ -735,12 +737,9 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
     edgesOverLimit = limited.edgesOverLimit;
     if (limited.iterations == 0) break;  // nothing over the limit: the collisions stand
     if (!colliders.empty()) {
-      // Friction was taken in the first pass; this one only keeps vertices out.
+      // Friction was taken in the first pass; this one only keeps vertices and faces out.
       selectResponseColliders(colliders);
-      (void)m_colliderResponse.resolve(m_nearColliders, m_stepStartPositions,
-                                       m_stepStartVelocities, m_settings.material.thickness,
-                                       m_pinnedMask, m_positions, m_velocities, &m_contactHolds,
-                                       /*friction=*/false);
+      keepVerticesOutOfColliders();
       (void)resolveFaceContacts();
     }
     if (selfCollision) resolveSelfCollision(h, colliders, report);

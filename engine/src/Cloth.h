@@ -204,6 +204,9 @@ class Cloth final : public DynamicSystem {
   // Keeps faces out of the colliders (ColliderFaceContacts) after a collider pass,
   // and then the vertices out of every collider again; returns the face contacts.
   Index resolveFaceContacts();
+  // The collider response's keep-out pass over m_nearColliders, without friction, updating the
+  // contact holds (the limiter's rounds, and after a face pass).
+  void keepVerticesOutOfColliders();
   // The colliders near the substep's start and current positions, into m_nearColliders.
   void selectResponseColliders(std::span<const ColliderFrame> colliders);
   // Colliders whose box comes within the contact distance of `points` go to m_nearColliders;
@@ -268,7 +271,7 @@ class Cloth final : public DynamicSystem {
   bool m_selfContactsLastStep = false;
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
-  ColliderFaceContacts m_faceContacts;             // faces against round bodies, this pass
+  ColliderFaceContacts m_faceContacts;             // faces against the colliders, this pass
   ClothStageCounters m_stages;                     // this frame's
   bool m_sleeping = false, m_wakeRequested = false;
   Index m_quietFrames = 0;

@@ -18,6 +18,15 @@ constexpr int kMaxSweeps = 4;
 // m: a sweep that moved no face point farther than this ends the loop (round-off, not contact).
 constexpr Real kSettledDepth = 1e-9;
 
+// A core from `start` to `end` kept `reach` away from, with its box.
+FaceCore makeCore(const Vec3& start, const Vec3& end, Real reach) {
+  FaceCore core{start, end, reach, Aabb::empty()};
+  core.box.expand(start);
+  core.box.expand(end);
+  core.box.inflate(std::max<Real>(reach, 0));
+  return core;
+}
+
 // The cores of a body in its own frame that faces are kept away from (see the design note): a
 // sphere's centre (a segment of length 0) and a capsule's segment, each `radius` − allowance (at
 // least half the allowance); a
@@ -31,10 +40,10 @@ void appendCores(const Shape& shape, Real allowance, std::vector<FaceCore>& core
     return std::max(radius - allowance, 0.5 * allowance);
   };
   if (const Sphere* sphere = std::get_if<Sphere>(&shape)) {
-    cores.push_back({Vec3::Zero(), Vec3::Zero(), roundReach(sphere->radius())});
+    cores.push_back(makeCore(Vec3::Zero(), Vec3::Zero(), roundReach(sphere->radius())));
   } else if (const Capsule* capsule = std::get_if<Capsule>(&shape)) {
     const Vec3 half(0, capsule->halfLength(), 0);
-    cores.push_back({-half, half, roundReach(capsule->radius())});
+    cores.push_back(makeCore(-half, half, roundReach(capsule->radius())));
   } else if (const Box* box = std::get_if<Box>(&shape)) {
     const Vec3& e = box->halfExtents();
     for (int axis = 0; axis < 3; ++axis) {
@@ -46,7 +55,7 @@ void appendCores(const Shape& shape, Real allowance, std::vector<FaceCore>& core
         Vec3 b = a;
         a[axis] = -e[axis];
         b[axis] = e[axis];
-        cores.push_back({a, b, 0.5 * allowance});
+        cores.push_back(makeCore(a, b, 0.5 * allowance));
       }
     }
   }
@@ -144,6 +153,25 @@ int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const 
   return count;
 }
 
+// Σ b_k² w_k over a face's corners: the inverse mass a face point of barycentric weights `b` has
+// against an immovable body.
+Real pointInverseMass(const Vec3& b, const std::array<Index, 3>& corner,
+                      std::span<const Real> inverseMasses) {
+  Real weight = 0;
+  for (int j = 0; j < 3; ++j) weight += b[j] * b[j] * inverseMasses[corner[j]];
+  return weight;
+}
+
+// Moves the face point of weights `b` by amount · direction in `values` (positions or
+// velocities): corner k by b_k w_k / weight · amount · direction, weight = pointInverseMass.
+void moveFacePoint(const Vec3& b, const std::array<Index, 3>& corner,
+                   std::span<const Real> inverseMasses, Real weight, Real amount,
+                   const Vec3& direction, Vec3Array& values) {
+  for (int j = 0; j < 3; ++j) {
+    values[corner[j]] += (b[j] * inverseMasses[corner[j]] / weight * amount) * direction;
+  }
+}
+
 }  // namespace
 
 ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> colliders,
@@ -208,17 +236,14 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         m_meshEdges.erase(std::unique(m_meshEdges.begin(), m_meshEdges.end()), m_meshEdges.end());
         coresBegin = Index(m_cores.size());
         for (const auto& [a, b] : m_meshEdges) {
-          m_cores.push_back({mesh->localVertices()[a], mesh->localVertices()[b], 0.5 * allowance});
+          m_cores.push_back(
+              makeCore(mesh->localVertices()[a], mesh->localVertices()[b], 0.5 * allowance));
         }
         coresEnd = Index(m_cores.size());
       }
       for (Index c = coresBegin; c < coresEnd; ++c) {
         const FaceCore& core = m_cores[c];
-        Aabb reach = Aabb::empty();
-        reach.expand(core.start);
-        reach.expand(core.end);
-        reach.inflate(std::max<Real>(core.reach, 0));
-        if (!reach.overlaps(path)) continue;
+        if (!core.box.overlaps(path)) continue;
         // Which side of the core the face started on (zero: it started on the core).
         const SegmentTriangleClosestPoints before = closestPointsOnSegmentAndTriangle(
             core.start, core.end, startLocal[0], startLocal[1], startLocal[2]);
@@ -256,13 +281,10 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         const FacePoint& point = points[p];
         if (!(point.depth > 0)) continue;
         const Vec3& b = point.barycentric;
-        Real weight = 0;
-        for (int j = 0; j < 3; ++j) weight += b[j] * b[j] * inverseMasses[corner[j]];
+        const Real weight = pointInverseMass(b, corner, inverseMasses);
         if (!(weight > 0)) continue;
-        const Vec3 worldNormal = endPose.directionToWorld(point.normal);
-        for (int j = 0; j < 3; ++j) {
-          x[corner[j]] += (b[j] * inverseMasses[corner[j]] / weight * point.depth) * worldNormal;
-        }
+        moveFacePoint(b, corner, inverseMasses, weight, point.depth,
+                      endPose.directionToWorld(point.normal), x);
         pushed = true;
         moved = moved || point.depth > kSettledDepth;
         // The next point of this face sees the face where this push left it.
@@ -304,20 +326,15 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
       hold.normal = normal;
       hold.separation = normal.dot(corePoint) + m_cores[candidate.core].reach;
       m_holds.push_back(hold);
-      Real weight = 0;
+      const Real weight = pointInverseMass(b, corner, inverseMasses);
+      if (!(weight > 0)) continue;
       Vec3 facePoint = Vec3::Zero(), faceVelocity = Vec3::Zero();
       for (int j = 0; j < 3; ++j) {
-        weight += b[j] * b[j] * inverseMasses[corner[j]];
         facePoint += b[j] * x[corner[j]];
         faceVelocity += b[j] * v[corner[j]];
       }
-      if (!(weight > 0)) continue;
       const Real approach = (faceVelocity - body.velocityAt(facePoint)).dot(normal);
-      if (approach < 0) {
-        for (int j = 0; j < 3; ++j) {
-          v[corner[j]] -= (b[j] * inverseMasses[corner[j]] / weight * approach) * normal;
-        }
-      }
+      if (approach < 0) moveFacePoint(b, corner, inverseMasses, weight, -approach, normal, v);
     }
   }
   return report;

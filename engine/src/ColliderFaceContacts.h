@@ -65,6 +65,7 @@
 #include "StrainLimiting.h"
 
 #include <weft/Math.h>
+#include <weft/collision/Aabb.h>
 #include <weft/engine/ClothModel.h>
 
 #include <span>
@@ -79,6 +80,7 @@ struct FaceCore {
   Vec3 start = Vec3::Zero();
   Vec3 end = Vec3::Zero();
   Real reach = 0;
+  Aabb box;  ///< the segment's box inflated by the reach (at least 0): where a face can touch it
 };
 
 /// What one resolve() did.
