@@ -44,14 +44,23 @@ Index ColliderResponse::constrain(std::span<const ColliderFrame> colliders, cons
       const Vec3 carriedStart = collider.end.pose.toWorld(collider.start.pose.toLocal(x[i]));
       Real depth;  // signed distance of the predicted point along the chosen normal
       Vec3 direction;
+      const ShapeContact contact = queryPoint(*collider.shape, predicted);
+      direction = contact.normal;
+      depth = contact.distance;
       if (const std::optional<PathContact> hit =
               firstContact(*collider.shape, carriedStart, predicted, thickness)) {
-        direction = hit->normal;
-        depth = hit->distance + hit->normal.dot(predicted - hit->point);
-      } else {
-        const ShapeContact contact = queryPoint(*collider.shape, predicted);
-        direction = contact.normal;
-        depth = contact.distance;
+        // A path that stays outside the body after it comes near (the end outside, on the side
+        // it came to, and the middle from there clear too) is a graze: the end's own distance
+        // holds. Extrapolating the hit's tangent plane instead overshoots on a curved body: a
+        // sheet on top of a 15 cm sphere that pulls away sideways by 6.7 cm in a step ends
+        // 1.7 cm clear of it, and the plane put it 0.5 mm inside, so the solve held it against
+        // the sheet's tension with an impulse of 36 m/s, which friction then turned into drag.
+        const bool graze = contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
+                           queryPoint(*collider.shape, 0.5 * (hit->point + predicted)).distance > 0;
+        if (!graze) {
+          direction = hit->normal;
+          depth = hit->distance + hit->normal.dot(predicted - hit->point);
+        }
       }
       if (depth < deepest) {
         deepest = depth;
@@ -155,7 +164,8 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
                                                  Real thickness,
                                                  const std::vector<char>& pinned, Vec3Array& x,
                                                  Vec3Array& v, ContactHolds* holds,
-                                                 bool friction, Real positionStep) const {
+                                                 bool friction, Real positionStep,
+                                                 std::span<const Real> solveImpulses) const {
   ColliderResponseReport report;
   report.constrainedVertices = Index(m_constrained.size());
   if (colliders.empty()) return report;
@@ -180,8 +190,10 @@ ColliderResponseReport ColliderResponse::resolve(std::span<const ColliderFrame> 
       if (normalSpeed < 0) normalPart.setZero();
       // Coulomb friction: the normal velocity change over the step (from the solve's constraint
       // and from this pass) bounds how much tangential velocity friction may remove.
-      const Real normalChange =
-          std::max<Real>(0, (v[i] - vStart[i]).dot(contact.normal)) + std::max<Real>(0, -normalSpeed);
+      const Real solvePart = solveImpulses.empty()
+                                 ? std::max<Real>(0, (v[i] - vStart[i]).dot(contact.normal))
+                                 : std::max<Real>(0, solveImpulses[i]);
+      const Real normalChange = solvePart + std::max<Real>(0, -normalSpeed);
       const Vec3 kept = friction ? coulombFriction(tangential, normalChange, collider.friction)
                                  : tangential;
       v[i] = contact.velocity + normalPart + kept;

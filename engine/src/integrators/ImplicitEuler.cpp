@@ -59,6 +59,31 @@ void ImplicitEuler::resizeRows(Index rowCount) {
   m_correction.assign(rowCount, Vec3::Zero());
   m_rowRightHandSide.assign(rowCount, Vec3::Zero());
   m_rowMass.assign(rowCount, 0);
+  m_contactImpulse.assign(rowCount, 0);
+}
+
+void ImplicitEuler::measureContactImpulses(const DynamicSystem& system) {
+  // The solve meets A Δv = b on the free directions only; along a contact's constrained
+  // direction p the difference (A Δv − b)·p is the impulse the constraint gave the vertex (the
+  // self-contact couplings are part of A, as in the solve).
+  const BlockSparseMatrix& matrix = system.systemMatrix();
+  for (Index row = 0; row < Index(m_contactImpulse.size()); ++row) {
+    const ConstraintKind kind = m_filter.kind(row);
+    m_contactImpulse[row] = 0;
+    if (kind != ConstraintKind::OneDirection && kind != ConstraintKind::TwoDirections) continue;
+    m_contactImpulse[row] = m_filter.direction(row, 0).dot(
+        matrix.multiplyRow(row, m_correction) - m_rowRightHandSide[row]);
+  }
+  for (const ContactCoupling& term : m_rowCouplings) {
+    const Real rate = term.coefficient * couplingRate(term, m_correction);
+    for (int k = 0; k < 4; ++k) {
+      const Index row = term.rows[k];
+      if (row == kInvalidIndex) continue;
+      const ConstraintKind kind = m_filter.kind(row);
+      if (kind != ConstraintKind::OneDirection && kind != ConstraintKind::TwoDirections) continue;
+      m_contactImpulse[row] += rate * term.weights[k] * term.normal.dot(m_filter.direction(row, 0));
+    }
+  }
 }
 
 void ImplicitEuler::gatherCouplings(const DynamicSystem& system, const FreeVertexMap& map,
@@ -200,6 +225,14 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
     gatherCouplings(system, map, removedPins, h, /*newton=*/false);
     solve(system, report);
     map.scatter(m_correction, m_deltaV);
+  }
+  // The contact constraints' impulses of this solve (before any Newton correction, whose
+  // constraints are met already), for the system's friction.
+  if (m_filter.constrainedVertexCount() > Index(m_filteredRows.size())) {
+    measureContactImpulses(system);
+    system.receiveContactImpulses(m_contactImpulse);
+  } else {
+    system.receiveContactImpulses({});
   }
 
   // Newton iterations on M Δv = h f(x_n + h(v_n + Δv), v_n + Δv); pinned vertices stay on target
