@@ -655,6 +655,18 @@ void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
   }
 }
 
+void Cloth::receiveContactImpulses(std::span<const Real> byRow) {
+  // Rows to vertices, impulses to velocity changes: what ColliderResponse::resolve takes.
+  std::fill(m_solveContactImpulses.begin(), m_solveContactImpulses.end(), Real(0));
+  if (byRow.empty()) return;
+  const std::vector<Real>& mass = masses();
+  for (Index row = 0; row < Index(byRow.size()); ++row) {
+    if (byRow[row] == 0) continue;
+    const Index vertex = m_freeVertexMap.vertex(row);
+    m_solveContactImpulses[vertex] = byRow[row] / mass[vertex];
+  }
+}
+
 void Cloth::resolveSelfCollision(Real h, std::span<ColliderFrame> colliders,
                                  ClothFrameReport& report) {
   ++m_stages.selfCollisionPasses;
@@ -767,6 +779,8 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
       m_stepStartPositions = m_positions;
       m_stepStartVelocities = m_velocities;
     }
+    // The solve's contact impulses, for friction; none unless an implicit solve reports them.
+    m_solveContactImpulses.assign(vertexCount(), Real(0));
     if (m_settings.solver.tightCgTolerance > 0) {
       // Contact-aware accuracy (SolverSettings::tightCgTolerance): jammed or yanked, solve tighter.
       if (m_jammed || yanked) {
@@ -803,11 +817,16 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
     }
     Index contacts = 0;
     if (!colliders.empty()) {
+      // Friction moves positions as well as velocities (positionStep h: a sticking contact does
+      // not creep h² a_t a step) and is bounded by the impulse of the solve's contact constraint
+      // (m_solveContactImpulses), not by the step's velocity change, which that constraint
+      // cancels. ColliderResponse.h has the measurements.
       selectResponseColliders(colliders);
       const ColliderResponseReport contact = m_colliderResponse.resolve(
           m_nearColliders, m_stepStartPositions, m_stepStartVelocities,
           m_settings.material.thickness, m_pinnedMask, m_positions, m_velocities,
-          m_strainLimiter ? &m_contactHolds : nullptr);
+          m_strainLimiter ? &m_contactHolds : nullptr, /*friction=*/true, /*positionStep=*/h,
+          m_solveContactImpulses);
       report.contacts = contact.contacts;
       const Index faceContacts = resolveFaceContacts();
       report.faceContacts += faceContacts;

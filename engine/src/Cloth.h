@@ -82,6 +82,7 @@ class Cloth final : public DynamicSystem {
   TaskSystem* taskSystem() override { return m_tasks; }
   void constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                          VertexFilter& filter) override;
+  void receiveContactImpulses(std::span<const Real> byRow) override;
   std::span<const ContactCoupling> contactCouplings() const override { return m_contactCouplings; }
 
   /// Advances by one frame of length frameDt starting at world time t, against colliders whose
@@ -284,6 +285,9 @@ class Cloth final : public DynamicSystem {
   std::vector<Real> m_inverseMasses;               // 0 for pinned vertices
   std::span<const ColliderFrame> m_colliders;  // this substep's colliders
   Vec3Array m_stepStartPositions, m_stepStartVelocities;
+  // By vertex, m/s: the normal velocity change the solve's contact constraint gave each vertex
+  // this substep (receiveContactImpulses), the friction bound of the collider response.
+  std::vector<Real> m_solveContactImpulses;
   std::vector<RigidMotion> m_frameStartMotions;
   std::vector<Index> m_pinSlotOfSorted;  // index into settings.pinnedVertices for each sorted pin
   Vec3Array m_pinStart, m_pinEnd;      // targets at frame start and end, in settings order

@@ -8,7 +8,6 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
-#include <cstdio>
 
 namespace weft {
 namespace {
@@ -57,25 +56,15 @@ TEST(Collider, ClothDropsOntoASphereAndRestsOnIt) {
       EXPECT_LT(lateEnergy / 30, 2e-3);
     }
   }
-  // Resting: the centre stays on top for the 5 s. A known engine failure: friction acts on
-  // velocities only, so a contact that sticks has still moved h v_t in the solve, and the drape
-  // creeps off. The centre's distance from the pole grows about 1.6x every half second from
-  // whatever asymmetry the solves leave (1 cm at frame 60 with the PCG's progress test every
-  // 4th iteration, 3 cm with it at every iteration): the centre is 1 cm below the top from frame
-  // 199 or 98, and the drape leaves the sphere at frame ~310 or ~205. Until 2026-11-22 this was
-  // asserted at frame 150 only, which the first rule passed and the second (and the first at a
-  // tolerance of 3e-2, or a window of 2 or 5) did not: a transient, not a rest. With friction's
-  // velocity change applied to positions too (ColliderResponse::resolve's positionStep, not
-  // passed by Cloth: it flips three other contact tests) the drape stays for 700 frames at every
-  // tolerance tried. See ColliderResponse.h.
+  // Resting: the centre stays on top for the 5 s. Until 2026-11-23 a known engine failure:
+  // friction acted on velocities only, so a contact that sticks had still moved h v_t in the
+  // solve, and the drape crept off (the centre 1 cm below the top from frame 98 to 199 by
+  // solver tolerance, off the sphere by frame ~205-310). Friction now moves positions too
+  // (ColliderResponse::resolve's positionStep) and is bounded by the solve's contact impulse
+  // (DynamicSystem::receiveContactImpulses): see ColliderResponse.h.
   EXPECT_TRUE(landed) << "the centre never reached the top of the sphere";
-  if (leftTheTop >= 0) {
-    std::printf("KNOWN ENGINE FAILURE: the drape's centre left the top at frame %d (friction creep)\n",
-                leftTheTop);
-    GTEST_SKIP() << "known engine failure: the drape creeps off the sphere (the centre more than 1 cm "
-                    "below the top from frame " << leftTheTop << "; velocity-level friction lets a "
-                    "sticking contact move h v_t a step, ColliderResponse.h)";
-  }
+  EXPECT_EQ(leftTheTop, -1) << "the drape's centre left the top (more than 1 cm off it) at frame "
+                            << leftTheTop;
 }
 
 TEST(Collider, ClothFallsOntoTheFloorAndStaysAboveIt) {

@@ -72,6 +72,13 @@ class DynamicSystem {
     (void)x, (void)v, (void)h, (void)filter;
   }
 
+  /// After an implicit step: by row of systemMatrix(), the impulse (N·s) the row's contact
+  /// constraint applied along its constrained direction in the solve, (A Δv − b)·p (Baraff &
+  /// Witkin's constraint force times h; positive pushes along p), zero for a row without one.
+  /// The step's velocity change hides it (the constraint cancels the forces it resists), and
+  /// Coulomb friction needs it (ColliderResponse). Default: ignored.
+  virtual void receiveContactImpulses(std::span<const Real> byRow) { (void)byRow; }
+
   /// Rank-one couplings of the system matrix outside its block pattern, from the last
   /// linearize() (self-contacts, ContactCoupling.h): the full matrix is systemMatrix() +
   /// Σ coefficient · JᵀJ, their forces are already in f. Indexed by vertex (not by row). Default:

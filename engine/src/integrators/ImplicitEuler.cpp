@@ -16,6 +16,14 @@ namespace {
 // pair within a thickness at the start kept, pulling or not) the default-tolerance drop stood
 // as a 15 cm pile still stirring at 1e-4 J after 400 frames: the springs glued the layers.
 constexpr int kContactReleasePasses = 2;
+// Re-solves of a step after contact constraints that pulled were released (BW98 §5.3): a
+// constraint whose impulse (A Δv − b)·n is negative holds a vertex on a collider that the
+// cloth's forces would take off it. A released vertex is free in the re-solve; the collider
+// response still keeps it out. The curtain takes 11.5 CG iterations per frame with the friction
+// changes of 2026-11-23 (11.2 before; ColliderResponse.h). Without the release the pressed
+// shell of ColliderResponse::constrain glued cloth to the floor (ColliderSliding's sheet,
+// pulled 1.5 m up, stayed down: strain 29).
+constexpr int kConstraintReleasePasses = 2;
 
 }  // namespace
 
@@ -59,6 +67,31 @@ void ImplicitEuler::resizeRows(Index rowCount) {
   m_correction.assign(rowCount, Vec3::Zero());
   m_rowRightHandSide.assign(rowCount, Vec3::Zero());
   m_rowMass.assign(rowCount, 0);
+  m_contactImpulse.assign(rowCount, 0);
+}
+
+void ImplicitEuler::measureContactImpulses(const DynamicSystem& system) {
+  // The solve meets A Δv = b on the free directions only; along a contact's constrained
+  // direction p the difference (A Δv − b)·p is the impulse the constraint gave the vertex (the
+  // self-contact couplings are part of A, as in the solve).
+  const BlockSparseMatrix& matrix = system.systemMatrix();
+  for (Index row = 0; row < Index(m_contactImpulse.size()); ++row) {
+    const ConstraintKind kind = m_filter.kind(row);
+    m_contactImpulse[row] = 0;
+    if (kind != ConstraintKind::OneDirection && kind != ConstraintKind::TwoDirections) continue;
+    m_contactImpulse[row] = m_filter.direction(row, 0).dot(
+        matrix.multiplyRow(row, m_correction) - m_rowRightHandSide[row]);
+  }
+  for (const ContactCoupling& term : m_rowCouplings) {
+    const Real rate = term.coefficient * couplingRate(term, m_correction);
+    for (int k = 0; k < 4; ++k) {
+      const Index row = term.rows[k];
+      if (row == kInvalidIndex) continue;
+      const ConstraintKind kind = m_filter.kind(row);
+      if (kind != ConstraintKind::OneDirection && kind != ConstraintKind::TwoDirections) continue;
+      m_contactImpulse[row] += rate * term.weights[k] * term.normal.dot(m_filter.direction(row, 0));
+    }
+  }
 }
 
 void ImplicitEuler::gatherCouplings(const DynamicSystem& system, const FreeVertexMap& map,
@@ -200,6 +233,30 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
     gatherCouplings(system, map, removedPins, h, /*newton=*/false);
     solve(system, report);
     map.scatter(m_correction, m_deltaV);
+  }
+  // The contact constraints' impulses of this solve (before any Newton correction, whose
+  // constraints are met already), for the system's friction. A constraint that pulls (negative
+  // impulse: the cloth's forces would take the vertex off the surface) is released and the step
+  // solved again (Baraff & Witkin 1998, §5.3), a few times at most: a contact may only push.
+  if (m_filter.constrainedVertexCount() > Index(m_filteredRows.size())) {
+    measureContactImpulses(system);
+    for (int pass = 0; pass < kConstraintReleasePasses; ++pass) {
+      bool released = false;
+      for (Index row = 0; row < rows; ++row) {
+        if (m_contactImpulse[row] < 0 && m_filter.kind(row) == ConstraintKind::OneDirection) {
+          m_filter.setFree(row);
+          m_contactImpulse[row] = 0;
+          released = true;
+        }
+      }
+      if (!released) break;
+      solve(system, report);
+      map.scatter(m_correction, m_deltaV);
+      measureContactImpulses(system);
+    }
+    system.receiveContactImpulses(m_contactImpulse);
+  } else {
+    system.receiveContactImpulses({});
   }
 
   // Newton iterations on M Δv = h f(x_n + h(v_n + Δv), v_n + Δv); pinned vertices stay on target

@@ -63,6 +63,9 @@ class ImplicitEuler final : public Integrator {
   // linear model, pushes (h F_end = impulse − coefficient · J Δv > 0, Δv = m_deltaV by vertex);
   // true when the active set changed.
   bool updateActiveCouplings(const DynamicSystem& system, Real h);
+  // The impulse (A Δv − b)·p of each contact-constrained row after the solve, into
+  // m_contactImpulse (zero for the other rows), for DynamicSystem::receiveContactImpulses.
+  void measureContactImpulses(const DynamicSystem& system);
 
   SolverSettings m_settings;
   FilteredPcg m_pcg;
@@ -81,6 +84,7 @@ class ImplicitEuler final : public Integrator {
   Vec3Array m_prescribedPosition, m_prescribedVelocity;
   std::vector<ContactCoupling> m_rowCouplings;  // the system's active contact couplings, by row
   std::vector<char> m_couplingActive;           // per system coupling: 1 while it pushes
+  std::vector<Real> m_contactImpulse;  // by row: N·s along the contact constraint, 0 if none
   bool m_hasWarmStart = false;
 };
 
