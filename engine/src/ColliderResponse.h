@@ -64,7 +64,7 @@
 // within 1.05, against 163 and 169): a shift along the tangent leaves a curved body by s²/2R.
 // Putting the shifted vertex back at its distance raised those to 88 and 104 but the drag only to
 // 0.083 (and moved the curtain's hash), so it is not the cause and is not in. The corner-crumple
-// piles stand taller and two tests fail (tests/README.md, "friction and the piles"): measured,
+// piles stand taller (tests/README.md, "friction and the piles", which says what those tests assert now): measured,
 // the position step and the pressed shell each raise them, because the floor now holds. Without
 // the position step the corner the cloth lands on creeps h² a_t a step and the sheet topples flat
 // (3 mm) with few self-contacts; without the shell 99 % of the resting vertex-steps of the drops

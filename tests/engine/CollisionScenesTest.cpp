@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace weft {
 namespace {
@@ -71,10 +72,19 @@ TEST(CollisionScenes, AClothDroppedOnACornerCrumplesOnTheFloor) {
     ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
     ASSERT_GE(closestApproach(world, cloth, floor), 0.0) << "a vertex is inside, frame " << frame;
   }
-  // Down on the floor, lying on itself in places.
+  // Down on the floor, lying on itself in places. How tall the pile stands is a chaotic outcome
+  // held up by the floor's static friction (tests/README.md, "friction and the piles"): 7.9 … 23
+  // cm at this frame over 16 drops from 27 to 31.7 cm, mean vertex height 2.6 … 11.5 cm. So this
+  // asserts that the sheet came down instead of standing: its mean vertex height is below a
+  // quarter of its side, where a sheet standing on an edge holds it at half its side. (Until
+  // 2026-11-23 it asserted a highest vertex below 10 cm, met through the creep of the old friction
+  // and a floor that gave way in the solve.)
+  const std::span<const Vec3> x = world.positions(cloth).value();
   Real highest = 0;
-  for (const Vec3& p : world.positions(cloth).value()) highest = std::max(highest, p.y());
-  EXPECT_LT(highest, 0.1);
+  for (const Vec3& p : x) highest = std::max(highest, p.y());
+  std::printf("[corner drop] highest vertex %.3f m, mean height %.3f m\n", highest,
+              test::meanVertexHeight(x));
+  EXPECT_LT(test::meanVertexHeight(x), kSize / 4);
   EXPECT_GT(selfContacts, 0u);
 }
 

@@ -123,6 +123,14 @@ inline ClothSettings cornerDrop(const ClothModel& model, Real lift) {
   return settings;
 }
 
+/// Mean height of the vertices (m): how far a pile has come down. A sheet standing on an edge
+/// holds it at half its side, one lying flat at its thickness.
+inline Real meanVertexHeight(std::span<const Vec3> positions) {
+  Real sum = 0;
+  for (const Vec3& p : positions) sum += p.y();
+  return sum / Real(positions.size());
+}
+
 /// The napkin fold's pin targets: the row pinned at z = +size/2 (start) carried by the fraction
 /// `s` ∈ [0, 1] of a half turn about the x axis through the middle, ending 2 cm above the floor.
 inline std::vector<Vec3> napkinFoldTargets(const std::vector<Vec3>& start, Real s, Real size) {

@@ -29,7 +29,8 @@ TEST(SelfContactSolve, ACrumpledPileSettlesAtATightSolverTolerance) {
   // 1e-5 J for all 9 drop heights measured from 28 to 31 cm (5e-8 … 7.4e-6 J), against 2 of 9
   // without (tests/README.md): a chaotic scene, so this asserts the measured margin, not a bit
   // pattern.
-  const std::shared_ptr<const ClothModel> model = horizontalSquare(15, 0.6, 0.0);
+  constexpr Real kSize = 0.6;  // m
+  const std::shared_ptr<const ClothModel> model = horizontalSquare(15, kSize, 0.0);
   for (Real lift : {0.300, 0.302}) {
     World world;
     const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
@@ -50,9 +51,11 @@ TEST(SelfContactSolve, ACrumpledPileSettlesAtATightSolverTolerance) {
     }
     EXPECT_GT(selfContacts, 1000u) << "lift " << lift << ": the cloth lay on itself";
     EXPECT_LT(world.stats().kineticEnergy, 1e-5) << "lift " << lift << ": still stirring";
-    Real highest = 0;
-    for (const Vec3& p : world.positions(cloth).value()) highest = std::max(highest, p.y());
-    EXPECT_LT(highest, 0.1) << "lift " << lift;
+    // Down, not standing (CollisionScenes.AClothDroppedOnACornerCrumplesOnTheFloor): 16 settled
+    // drops from 27 to 31.7 cm stand 8.6 … 24 cm tall, mean vertex height 3.2 … 10.2 cm, held up
+    // by the floor's static friction (tests/README.md, "friction and the piles").
+    const std::span<const Vec3> x = world.positions(cloth).value();
+    EXPECT_LT(test::meanVertexHeight(x), kSize / 4) << "lift " << lift;
   }
 }
 
