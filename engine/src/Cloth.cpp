@@ -43,6 +43,10 @@ constexpr Real kWakeMargin = 0.01;
 // vertex a tenth of the thickness was tried, and let a crossing through (stress scene 10) and
 // left the jammed layers of scene 7 at strain 2.3 instead of 0.26.
 constexpr int kContactLimitPasses = 6;
+// A face the last face pass left on a body is constrained in the next solve while it rests
+// within this fraction of the contact thickness beyond its reach (Cloth::constrainFaceCorners),
+// as ColliderResponse's pressed shell holds a resting vertex.
+constexpr Real kFacePressedShell = 0.01;
 // kHeldContactMassRatio (StrainLimiting.h, shared with ClothClothCollision): a self-contact is
 // held inside the strain limiter (one-sided, StrainLimiter::applyInContact's `separations`) when
 // one of its vertices is more than this many times heavier than another.
@@ -355,6 +359,7 @@ void Cloth::buildSystemRows() {
   m_contactFilter.resize(m_freeVertexMap.isIdentity() ? 0 : n);
   m_contactRows.clear();
   m_contactRows.reserve(m_freeVertexMap.rowCount());
+  m_faceConstrainedCorners.reserve(vertexCount());  // a corner is constrained once at most
 }
 
 void Cloth::estimateStiffestMode() {
@@ -634,15 +639,20 @@ void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
   }
   selectNearColliders(m_colliders, predicted, &start);
   if (m_freeVertexMap.isIdentity()) {
+    // The face corners first: ColliderResponse frees only the vertices it constrained itself.
+    for (Index corner : m_faceConstrainedCorners) filter.setFree(corner);
     m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
                                  m_pinnedMask, filter);
+    constrainFaceCorners(x, v, h, filter);
     return;
   }
   // Pins are removed from the solve: gather the contacts by vertex, then copy them (bit for bit)
   // into the rows of the solve's filter. Pinned vertices are never constrained, so every
   // constrained vertex has a row.
+  for (Index corner : m_faceConstrainedCorners) m_contactFilter.setFree(corner);
   m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
                                m_pinnedMask, m_contactFilter);
+  constrainFaceCorners(x, v, h, m_contactFilter);
   for (Index row : m_contactRows) filter.setFree(row);
   m_contactRows.clear();
   if (m_contactFilter.constrainedVertexCount() == 0) return;
@@ -652,6 +662,41 @@ void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
     if (row == kInvalidIndex) continue;
     filter.copyConstraint(row, m_contactFilter, i);
     m_contactRows.push_back(row);
+  }
+}
+
+void Cloth::constrainFaceCorners(const Vec3Array& x, const Vec3Array& v, Real h,
+                                 VertexFilter& filter) {
+  // A face resting on a body thinner than its triangles (a towel on a rod) carries the cloth's
+  // weight on the face alone: its corners are clear of the body, so the vertex constraints do
+  // not hold them, and the solve let the cloth sink into the body by up to h² g a step (2.7 mm at
+  // 1/60 s) for the face pass to push it back out. Those pushes, distributed by barycentric
+  // weight over a triangulation whose diagonals all run one way, carried the towel along the rod
+  // at a steady 9.5 cm/s (the floor that gave way in the solve, for faces; ColliderResponse.h).
+  // Here each such face's corners are constrained along its contact normal so that the face
+  // point ends the step at its reach (one that rests a little clear comes down onto it, as a
+  // pressed vertex does); a constraint that pulls is released by the solve like a vertex's.
+  m_faceConstrainedCorners.clear();
+  if (!m_settings.faceContacts || m_colliders.empty()) return;
+  const Real shell = kFacePressedShell * m_settings.material.thickness;
+  for (const SeparationHold& hold : m_faceContacts.holds()) {
+    Vec3 point = Vec3::Zero(), velocity = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      point += hold.weights[k] * x[hold.vertices[k]];
+      velocity += hold.weights[k] * v[hold.vertices[k]];
+    }
+    const Real gap = hold.normal.dot(point) - hold.separation;  // m, ≥ 0: at or beyond the reach
+    if (gap > shell && gap + h * hold.normal.dot(velocity) > 0) continue;  // stays clear
+    const Real speed = -gap / h;  // m/s along the normal that ends the step at the reach
+    for (int k = 0; k < 3; ++k) {
+      const Index corner = hold.vertices[k];
+      if (!(hold.weights[k] > 0) || m_pinnedMask[corner] || filter.kind(corner) != ConstraintKind::Free) {
+        continue;
+      }
+      filter.setConstrained(corner, hold.normal,
+                            (speed - hold.normal.dot(v[corner])) * hold.normal);
+      m_faceConstrainedCorners.push_back(corner);
+    }
   }
 }
 
@@ -682,12 +727,12 @@ void Cloth::resolveSelfCollision(Real h, std::span<ColliderFrame> colliders,
   m_stages.bvhNodesSkipped += refits.skippedNodes;
 }
 
-Index Cloth::resolveFaceContacts() {
+Index Cloth::resolveFaceContacts(Real frictionStep) {
   if (!m_settings.faceContacts) return 0;
-  const ColliderFaceReport faces =
-      m_faceContacts.resolve(m_nearColliders, m_model->triangles(), m_stepStartPositions,
-                             m_inverseMasses, m_settings.material.thickness, m_positions,
-                             m_velocities);
+  const ColliderFaceReport faces = m_faceContacts.resolve(
+      m_nearColliders, m_model->triangles(), m_stepStartPositions, m_inverseMasses,
+      m_settings.material.thickness, m_positions, m_velocities, frictionStep > 0, frictionStep,
+      m_solveContactImpulses);
   // Pushing a face out of one body can move its corners into another (a sheet pressed between
   // a ring and a pusher): the vertices keep the last word.
   if (faces.contacts > 0) keepVerticesOutOfColliders();
@@ -752,7 +797,7 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
       // Friction was taken in the first pass; this one only keeps vertices and faces out.
       selectResponseColliders(colliders);
       keepVerticesOutOfColliders();
-      (void)resolveFaceContacts();
+      (void)resolveFaceContacts(/*frictionStep=*/0);
     }
     if (selfCollision) resolveSelfCollision(h, colliders, report);
   }
@@ -828,7 +873,7 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
           m_strainLimiter ? &m_contactHolds : nullptr, /*friction=*/true, /*positionStep=*/h,
           m_solveContactImpulses);
       report.contacts = contact.contacts;
-      const Index faceContacts = resolveFaceContacts();
+      const Index faceContacts = resolveFaceContacts(/*frictionStep=*/h);
       report.faceContacts += faceContacts;
       contacts = contact.contacts + faceContacts;
     } else {

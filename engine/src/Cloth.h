@@ -203,8 +203,14 @@ class Cloth final : public DynamicSystem {
   Index limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bool selfCollision,
                              Index edgesOverLimit, ClothFrameReport& report);
   // Keeps faces out of the colliders (ColliderFaceContacts) after a collider pass,
-  // and then the vertices out of every collider again; returns the face contacts.
-  Index resolveFaceContacts();
+  // and then the vertices out of every collider again; returns the face contacts. The step's
+  // first pass passes its step h (s) as `frictionStep`: faces take friction, moving positions by
+  // h times its velocity change; later passes pass 0, none (the vertex pass does the same).
+  Index resolveFaceContacts(Real frictionStep);
+  // Constrains in the solve, along the contact normal, the corners of the faces the last face
+  // pass left on a body (its holds), so that the solve does not sink them into it (see
+  // constrainContacts). Vertices already constrained keep their constraint.
+  void constrainFaceCorners(const Vec3Array& x, const Vec3Array& v, Real h, VertexFilter& filter);
   // The collider response's keep-out pass over m_nearColliders, without friction, updating the
   // contact holds (the limiter's rounds, and after a face pass).
   void keepVerticesOutOfColliders();
@@ -288,6 +294,8 @@ class Cloth final : public DynamicSystem {
   // By vertex, m/s: the normal velocity change the solve's contact constraint gave each vertex
   // this substep (receiveContactImpulses), the friction bound of the collider response.
   std::vector<Real> m_solveContactImpulses;
+  // Vertices constrainFaceCorners constrained in the last solve (freed before the next one).
+  std::vector<Index> m_faceConstrainedCorners;
   std::vector<RigidMotion> m_frameStartMotions;
   std::vector<Index> m_pinSlotOfSorted;  // index into settings.pinnedVertices for each sorted pin
   Vec3Array m_pinStart, m_pinEnd;      // targets at frame start and end, in settings order

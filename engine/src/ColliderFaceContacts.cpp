@@ -71,6 +71,14 @@ struct FacePoint {
   Real depth = 0;
 };
 
+// A face within this fraction of the allowance beyond its reach at the step start began the step
+// on the body: friction may move its position (ColliderResponse's pressed shell, for faces).
+constexpr Real kStartedOnShell = 0.01;
+
+// A face whose normal leans less than this (the cosine of its angle to the plane across a line
+// core) is pushed along its own normal: one nearly across the core, which pierces it.
+constexpr Real kLeastAcross = 0.5;
+
 // Points closer than this (m) outside the reach still count as touching: they get a limiter hold
 // and their approach velocity removed (a face the sweeps just put at the reach is at -1e-17).
 constexpr Real kTouching = 1e-9;
@@ -134,6 +142,19 @@ int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const 
         point.normal = side * up;
         point.corePoint = corePoint;
         point.depth = core.reach + side * height;  // the face point is −side·height from the core
+        if (line) {
+          // A line core (a capsule's axis, a box's edge) pushes across itself: the face's normal
+          // without its part along the core, which a face tilted along a rod would otherwise
+          // turn into a push along the rod (see the note). The depth is along that direction:
+          // moving the face point by it lifts the face's plane there by the height it lacks.
+          const Vec3 along = segment.normalized();
+          const Vec3 across = point.normal - point.normal.dot(along) * along;
+          const Real lift = across.norm();  // = cos of the tilt: its dot with the face normal
+          if (lift > kLeastAcross) {
+            point.normal = across / lift;
+            point.depth /= lift;
+          }
+        }
         if (point.depth > minDepth) ++count;
       }
     }
@@ -178,7 +199,9 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
                                                  std::span<const TriangleRest> triangles,
                                                  const Vec3Array& xStart,
                                                  std::span<const Real> inverseMasses,
-                                                 Real allowance, Vec3Array& x, Vec3Array& v) {
+                                                 Real allowance, Vec3Array& x, Vec3Array& v,
+                                                 bool friction, Real positionStep,
+                                                 std::span<const Real> solveImpulses) {
   ColliderFaceReport report;
   m_holds.clear();
   m_candidates.clear();
@@ -254,11 +277,13 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         if (before.distance > 0) {
           candidate.cameFrom = (before.pointOnTriangle - before.pointOnSegment) / before.distance;
         }
+        candidate.startedOn = before.distance <= core.reach + kStartedOnShell * allowance;
         m_candidates.push_back(candidate);
       }
     }
   }
   if (m_candidates.empty()) return report;
+  if (friction) m_cornerSlot.resize(x.size(), kInvalidIndex);  // allocates only when the cloth grows
 
   std::array<FacePoint, 3> points;
   const auto cornersInBody = [&](const Candidate& candidate, std::array<Vec3, 3>& local) {
@@ -266,39 +291,44 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
     const Pose& endPose = colliders[candidate.collider].end.pose;
     for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
   };
-  for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
-    ++report.sweeps;
-    bool moved = false;
-    for (Candidate& candidate : m_candidates) {
-      const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
-      const Pose& endPose = colliders[candidate.collider].end.pose;
-      std::array<Vec3, 3> local;
-      cornersInBody(candidate, local);
-      const int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0],
-                                   local[1], local[2], 0, points);
-      bool pushed = false;
-      for (int p = 0; p < count; ++p) {
-        const FacePoint& point = points[p];
-        if (!(point.depth > 0)) continue;
-        const Vec3& b = point.barycentric;
-        const Real weight = pointInverseMass(b, corner, inverseMasses);
-        if (!(weight > 0)) continue;
-        moveFacePoint(b, corner, inverseMasses, weight, point.depth,
-                      endPose.directionToWorld(point.normal), x);
-        pushed = true;
-        moved = moved || point.depth > kSettledDepth;
-        // The next point of this face sees the face where this push left it.
-        if (p + 1 < count) {
-          cornersInBody(candidate, local);
-          (void)facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                           local[2], -std::numeric_limits<Real>::infinity(), points);
+  // Pushes every face point short of its reach out, Gauss–Seidel in candidate order, sweeping
+  // again while a sweep moved a face, kMaxSweeps times at most.
+  const auto sweepOut = [&] {
+    for (int sweep = 0; sweep < kMaxSweeps; ++sweep) {
+      ++report.sweeps;
+      bool moved = false;
+      for (Candidate& candidate : m_candidates) {
+        const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
+        const Pose& endPose = colliders[candidate.collider].end.pose;
+        std::array<Vec3, 3> local;
+        cornersInBody(candidate, local);
+        int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0],
+                               local[1], local[2], 0, points);
+        bool pushed = false;
+        for (int p = 0; p < count; ++p) {
+          const FacePoint& point = points[p];
+          if (!(point.depth > 0)) continue;
+          const Vec3& b = point.barycentric;
+          const Real weight = pointInverseMass(b, corner, inverseMasses);
+          if (!(weight > 0)) continue;
+          moveFacePoint(b, corner, inverseMasses, weight, point.depth,
+                        endPose.directionToWorld(point.normal), x);
+          pushed = true;
+          moved = moved || point.depth > kSettledDepth;
+          // The next point of this face sees the face where this push left it.
+          if (p + 1 < count) {
+            cornersInBody(candidate, local);
+            count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                               local[2], -std::numeric_limits<Real>::infinity(), points);
+          }
         }
+        if (pushed && !candidate.pushed) ++report.contacts;
+        candidate.pushed = candidate.pushed || pushed;
       }
-      if (pushed && !candidate.pushed) ++report.contacts;
-      candidate.pushed = candidate.pushed || pushed;
+      if (!moved) break;
     }
-    if (!moved) break;
-  }
+  };
+  sweepOut();
   // Once the positions have settled: each touching face point is held one-sided in the strain
   // limiter (it slides the cloth round the body instead of pulling the face back in), and keeps
   // no velocity into the body (inelastic, relative to the body's surface there). Removed in
@@ -333,10 +363,49 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         facePoint += b[j] * x[corner[j]];
         faceVelocity += b[j] * v[corner[j]];
       }
-      const Real approach = (faceVelocity - body.velocityAt(facePoint)).dot(normal);
+      const Real approach =
+          std::min<Real>(0, (faceVelocity - body.velocityAt(facePoint)).dot(normal));
       if (approach < 0) moveFacePoint(b, corner, inverseMasses, weight, -approach, normal, v);
+      if (!friction || !candidate.startedOn) continue;
+      for (int j = 0; j < 3; ++j) {
+        const Index i = corner[j];
+        if (!(b[j] > 0) || inverseMasses[i] == 0) continue;
+        if (m_cornerSlot[i] == kInvalidIndex) {
+          // A corner resting on the body itself is a vertex contact: the vertex pass took its
+          // friction, bounded by its own constraint's impulse.
+          if (queryPoint(*colliders[candidate.collider].shape, x[i]).distance <
+              (1 + kStartedOnShell) * allowance) {
+            continue;
+          }
+          // Its solve impulse is the face constraint's (Cloth::constrainFaceCorners).
+          const Real solvePart = solveImpulses.empty() ? 0 : std::max<Real>(0, solveImpulses[i]);
+          m_cornerSlot[i] = Index(m_frictionCorners.size());
+          m_frictionCorners.push_back({normal, body.velocityAt(x[i]),
+                                       colliders[candidate.collider].friction, solvePart});
+          m_frictionVertices.push_back(i);
+        }
+        // The corner's share of the push just made (moveFacePoint's).
+        m_frictionCorners[m_cornerSlot[i]].normalChange -=
+            b[j] * inverseMasses[i] / weight * approach;
+      }
     }
   }
+  for (std::size_t k = 0; k < m_frictionCorners.size(); ++k) {
+    const Index i = m_frictionVertices[k];
+    const FrictionCorner& contact = m_frictionCorners[k];
+    m_cornerSlot[i] = kInvalidIndex;
+    const Vec3 relative = v[i] - contact.bodyVelocity;
+    const Vec3 tangential = relative - relative.dot(contact.normal) * contact.normal;
+    const Vec3 change =
+        coulombFriction(tangential, contact.normalChange, contact.friction) - tangential;
+    v[i] += change;
+    x[i] += positionStep * change;
+  }
+  // Friction's shift is along each corner's own tangent, which can tilt a face into the reach on
+  // a curved body (4.1 mm into the test's rod without this): the faces are put back out.
+  if (positionStep > 0 && !m_frictionCorners.empty()) sweepOut();
+  m_frictionCorners.clear();
+  m_frictionVertices.clear();
   return report;
 }
 

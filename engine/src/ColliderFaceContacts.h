@@ -30,8 +30,14 @@
 // linear, so its two ends are the deepest points (a box edge or a capsule parallel to the face
 // touches it along a line; the kernel's single closest point, on the face's edge, pushed one end
 // of that line and tilted the face about the other); beside the face, the closest points of the
-// segment and the triangle (Proximity.h) when they lie on the face's boundary. A face point short
-// of the reach is moved out along the contact normal by moving the three corners, each by its
+// segment and the triangle (Proximity.h) when they lie on the face's boundary. Over the interior
+// the contact normal of a line core (a capsule's axis, a box's edge) is the face's normal without
+// its part along the core, as a cylinder's surface normal is: a face lying tilted along a rod was
+// pushed along its own normal, which leans along the rod, and every push moved it along the rod
+// (with the sinking below, a towel resting on a rod rode along it at 9.5 cm/s and fell off its
+// end; scenes/data/rod-hang.json). A face point short of the reach is moved out along the
+// contact normal, lifting the face's plane there by the height it lacks, by moving the three
+// corners, each by its
 // barycentric weight b_k and inverse mass w_k: Δx_k = b_k w_k / (Σ_j b_j² w_j) · depth · n, which
 // moves the face point by exactly depth · n (the impulse distribution of Bridson, Fedkiw &
 // Anderson 2002 for a point–triangle contact, with the body infinitely heavy). Contacts are
@@ -56,9 +62,32 @@
 // cloth round the body instead of pulling the face back into it (on the rod of the test, max
 // strain 0.101 with the holds, 0.103 without).
 //
+// In the solve: Cloth constrains the corners of the faces a pass left on a body along the contact
+// normal in the next implicit solve (Cloth::constrainFaceCorners), so that a face carrying the
+// cloth's weight does not sink h² g a step into the body for this pass to push back out (the
+// floor that gave way in the solve, for faces: ColliderResponse.h). On the rod of the tests, over
+// the last 20 of 40 s, the towel moved 5 µm along the rod with the constraints and 1.9 cm
+// without; without the faces' friction as well, it slid round the rod and fell off.
+//
+// Friction, in the step's first pass only (as the vertex pass takes it), at the corners of the
+// touching faces, each corner once: its tangential velocity relative to the body (along the
+// normal of its first touching face point) is cut by μ times its normal velocity change in the
+// step, the solve's constraint's and this pass's share (coulombFriction), and with
+// `positionStep` its position moves by the same change times the step, so that a sticking face
+// does not creep. Only faces that began the step on the body (within 1 % of the allowance beyond
+// the reach) take friction: resting contact, which is what holds a towel on a rod. A face that
+// meets a body within the step leaves friction to its vertices: the stress suite's 250 m/s
+// sphere, which meets its sheet within a step, tore it when such faces were shifted by friction
+// (strain 2.7, and the sheet passed it) and stretched it to 0.1108 when they only took its
+// velocity change (0.109 without). Taken per face point instead, with the point's change spread
+// over the corners by barycentric weight, the points of neighbouring faces each moved a shared
+// corner by the whole of their own correction. A corner resting on the body itself is a vertex
+// contact and takes friction in the vertex pass only: taken here again (bounded by its vertex
+// constraint's impulse, and moved along the face's tangent plane, not the body's surface there),
+// it lifted the bottom of two layers draped over a sphere 1.1 cm off it (ClothClothTest).
+//
 // Not covered: a mesh's vertices poking into a face without an edge crossing it (a spike narrower
-// than the triangles), friction on face contacts (the vertex pass takes it), and a face inside a
-// body at both ends of a step with no side to return to.
+// than the triangles), and a face inside a body at both ends of a step with no side to return to.
 #pragma once
 
 #include "ColliderResponse.h"
@@ -96,11 +125,19 @@ class ColliderFaceContacts {
   /// Moves faces of `triangles` that are within reach of a core of a sphere, capsule, box or mesh
   /// (see the design note; `allowance` in m, Cloth passes the contact thickness) back out of it,
   /// and removes their velocity into the body. `xStart`: positions at the step start (which
-  /// side a face came from). Vertices with inverse mass 0 (pins) are not moved.
+  /// side a face came from). Vertices with inverse mass 0 (pins) are not moved. `friction`:
+  /// each face point whose approach velocity was removed also takes Coulomb friction against the
+  /// body (ColliderFrame::friction), bounded by that normal velocity change; `positionStep` (s)
+  /// > 0 moves its position by positionStep times friction's velocity change as well, as the
+  /// vertex pass does (ColliderResponse::resolve). A later pass in the same step passes false.
+  /// `solveImpulses` (m/s by vertex, may be empty): the normal velocity change the implicit
+  /// solve's contact constraints gave the corners (Cloth::constrainFaceCorners), which the bound
+  /// takes with the pass's own, weighted as the face point weights its corners.
   ColliderFaceReport resolve(std::span<const ColliderFrame> colliders,
                              std::span<const TriangleRest> triangles, const Vec3Array& xStart,
                              std::span<const Real> inverseMasses, Real allowance, Vec3Array& x,
-                             Vec3Array& v);
+                             Vec3Array& v, bool friction = false, Real positionStep = 0,
+                             std::span<const Real> solveImpulses = {});
 
   /// The contacts of the last resolve() as one-sided holds for the strain limiter.
   std::span<const SeparationHold> holds() const { return m_holds; }
@@ -115,12 +152,23 @@ class ColliderFaceContacts {
     Index core = 0;                // into m_cores
     Vec3 cameFrom = Vec3::Zero();  // body frame: the core-to-face normal at the step start
     bool pushed = false;           // moved by a sweep of this resolve()
+    bool startedOn = false;        // within its reach of the core at the step start (at rest on it)
   };
   std::vector<FaceCore> m_cores;         // every body's cores, this resolve()
   std::vector<Index> m_meshTriangles;    // a mesh's triangles near one face
   std::vector<std::pair<Index, Index>> m_meshEdges;  // their edges, each once
   std::vector<Candidate> m_candidates;  // a face and a core it may touch, this resolve()
   std::vector<SeparationHold> m_holds;
+  // Friction is taken at the corners of the touching faces, each corner once (see the note).
+  struct FrictionCorner {
+    Vec3 normal = Vec3::Zero();        // of its first touching face point
+    Vec3 bodyVelocity = Vec3::Zero();  // of that body at the corner
+    Real friction = 0;                 // that body's coefficient
+    Real normalChange = 0;             // m/s: the solve's and the pass's, for the face contacts
+  };
+  std::vector<Index> m_cornerSlot;  // by vertex: into m_frictionCorners, or kInvalidIndex
+  std::vector<FrictionCorner> m_frictionCorners;
+  std::vector<Index> m_frictionVertices;        // the vertex of each m_frictionCorners entry
 };
 
 }  // namespace weft

@@ -139,7 +139,10 @@ TEST(ColliderFaceContacts, ACapsuleMovingThroughAFaceIsFollowedInItsFrame) {
   // tilted as it was pushed).
   const SegmentTriangleClosestPoints gap =
       closestPointsOnSegmentAndTriangle(Vec3(-0.5, 0.03, 0), Vec3(0.5, 0.03, 0), x[0], x[1], x[2]);
-  EXPECT_NEAR(gap.distance, 0.02, 1e-9);
+  // Pushed across the rod at the two ends of the axis's part under the face, one after the other,
+  // each exact at its own point: the second lifts the first a little past the radius (0.15 mm).
+  EXPECT_GE(gap.distance, 0.02 - 1e-9);
+  EXPECT_LT(gap.distance, 0.02 + 5e-4);
   for (int k = 0; k < 3; ++k) EXPECT_GT(x[k].y(), 0.03) << "vertex " << k;
   for (int k = 0; k < 3; ++k) EXPECT_GE(v[k].y(), 0) << "vertex " << k;
   EXPECT_GT(v[0].y() + v[1].y() + v[2].y(), 1.8);
@@ -154,6 +157,7 @@ struct RodDrop {
   Real maxStrain = 0;
   std::uint64_t stateHash = 0;  // World::stateHash() at the end
   Index faceContacts = 0;       // StepStats::faceContacts, summed over the frames
+  Real axialDrift = 0;  // m, how far the mean vertex moved along the rod over the second half
 };
 enum class Support { Rod, Plank, MeshPlank };
 
@@ -196,7 +200,12 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
     EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
   }
   RodDrop result;
+  std::vector<Vec3> halfway;
   for (int frame = 0; frame < frames; ++frame) {
+    if (frame == frames / 2) {
+      const std::span<const Vec3> x = world.positions(cloth).value();
+      halfway.assign(x.begin(), x.end());
+    }
     EXPECT_EQ(world.step(1.0 / 60), StepStatus::Ok);
     result.maxStrain = std::max(result.maxStrain, world.stats().maxStrain);
     result.faceContacts += world.stats().faceContacts;
@@ -222,6 +231,10 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
   }
   result.stateHash = world.stateHash();
   const std::span<const Vec3> x = world.positions(cloth).value();
+  for (std::size_t i = 0; i < halfway.size(); ++i) {
+    result.axialDrift += (x[i].z() - halfway[i].z()) / Real(halfway.size());
+  }
+  result.axialDrift = std::abs(result.axialDrift);
   result.middleLowest = std::numeric_limits<Real>::infinity();
   for (Index row = 0; row < n; ++row) {
     result.middleLowest = std::min(result.middleLowest, x[row * n + n / 2].y());
@@ -259,6 +272,21 @@ TEST(ColliderFaceContacts, ASheetHangsOnAPlankThinnerThanItsTriangles) {
     const RodDrop vertices = dropOnRod(false, 40, plank);
     EXPECT_LT(vertices.middleLowest, 0.2) << "the plank no longer passes through the faces";
   }
+}
+
+TEST(ColliderFaceContacts, ATowelRestingOnARodByItsFacesStaysOnItWithoutRidingAlongIt) {
+  // Its vertices straddle the rod, clear of it, and it rests on its faces. Before this test, a
+  // face tilted along the rod was pushed along its own normal, which leans along the rod, and the
+  // solve sank the face into the rod every step for the face pass to push back out: the towel
+  // rode along the rod (9.5 cm/s in scenes/data/rod-hang.json) and fell off its end within 10 s.
+  // Measured over 40 s, 2,400 frames: the mean vertex moved 5 µm along the rod in the last 20 s
+  // and the middle column stayed on the rod's top; with faces pushed across the rod but without
+  // their corners constrained in the solve, 1.9 cm; without the faces' friction, it fell off.
+  const RodDrop towel = dropOnRod(true, 600);
+  EXPECT_GT(towel.middleLowest, 0.38) << "the towel is no longer on the rod";
+  EXPECT_LT(towel.axialDrift, 1e-3) << "the towel rides along the rod";
+  EXPECT_LT(towel.deepestFace, 0.003 + 1e-6);
+  EXPECT_LE(towel.maxStrain, cottonFabric().strainLimit + 0.01);
 }
 
 TEST(ColliderFaceContacts, AreBitwiseTheSameOnOneAndTwoThreads) {
