@@ -137,6 +137,19 @@ inline bool spansHeldMassRatio(const SeparationHold& pair, std::span<const Real>
   return lightest > kHeldContactMassRatio * heaviest;
 }
 
+/// Further one-sided constraints on positions that StrainLimiter::applyInContact satisfies together
+/// with its edges and separations (Gauss–Seidel): Cloth's collider contacts (ColliderProjection).
+class PositionConstraints {
+ public:
+  /// One pass over every constraint at the current x: each violated one is projected back onto
+  /// its bound, each position change Δx made also as the velocity change Δx · inverseStep.
+  /// Returns how many were violated by more than the implementation's tolerance.
+  virtual Index project(std::span<Vec3> x, std::span<Vec3> v, Real inverseStep) = 0;
+
+ protected:
+  ~PositionConstraints() = default;
+};
+
 /// How the strain limiter orders its corrections within one iteration.
 enum class StrainLimitOrder {
   /// One edge after the other, each seeing the corrections before it, in edge order and then
@@ -194,12 +207,14 @@ class StrainLimiter {
                                    std::span<const Real> inverseMasses,
                                    std::span<const Vec3> contactNormals, Real h, std::span<Vec3> x,
                                    std::span<Vec3> v, TaskSystem& tasks,
-                                   std::span<const SeparationHold> separations = {});
+                                   std::span<const SeparationHold> separations = {},
+                                   PositionConstraints* constraints = nullptr);
 
  private:
   StrainLimitReport run(const StrainLimitSettings& settings, std::span<const Real> inverseMasses,
                         std::span<const Vec3> contactNormals,
-                        std::span<const SeparationHold> separations, Real h, std::span<Vec3> x,
+                        std::span<const SeparationHold> separations,
+                        PositionConstraints* constraints, Real h, std::span<Vec3> x,
                         std::span<Vec3> v, TaskSystem& tasks);
 
   // One Gauss–Seidel pass over every edge over the limit, forward or backward in edge order.
