@@ -765,9 +765,12 @@ StrainLimitReport Cloth::projectInContact(Real h, bool selfCollision, bool joint
   if (joint) {
     // The collider contacts as one-sided constraints of the same iteration (ColliderProjection);
     // no vertex is held along a surface's normal, so the edges may also lift it off.
-    m_colliderProjection.prepare(m_nearColliders,
+    // The vertices against every collider of the substep (a vertex may be pulled towards one
+    // the skipped stages left out: the same bits with and without skipping), the faces against
+    // those their last pass was given.
+    m_colliderProjection.prepare(m_colliders,
                                  m_settings.faceContacts ? &m_faceContacts : nullptr,
-                                 m_model->triangles(), m_inverseMasses,
+                                 m_nearColliders, m_model->triangles(), m_inverseMasses,
                                  m_settings.material.thickness,
                                  std::max(m_settings.material.thickness,
                                           kProjectionMarginPerEdge * m_meanEdgeLength),
@@ -793,8 +796,8 @@ void Cloth::keepOutOfCollidersAfterProjection(std::span<ColliderFrame> colliders
   m_keepOutFromProjection = false;
 }
 
-bool Cloth::jointProjection(std::span<const ColliderFrame> colliders) const {
-  return m_settings.jointContactProjection && !colliders.empty() && !m_nearColliders.empty();
+bool Cloth::jointProjection() const {
+  return m_settings.jointContactProjection && m_colliderContacts > 0;
 }
 
 Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bool selfCollision,
@@ -807,7 +810,7 @@ Index Cloth::limitStrainInContact(Real h, std::span<ColliderFrame> colliders, bo
   // nothing to correct; if none does, a last projection has the last word (see
   // kJointProjectionRounds).
   WEFT_PROFILE_ZONE("strain limit in contact");
-  const bool joint = jointProjection(colliders);
+  const bool joint = jointProjection();
   m_substepSelfHolds.clear();
   const int rounds = joint ? kJointProjectionRounds : kContactLimitPasses;
   for (int pass = 0; pass < rounds; ++pass) {
@@ -913,8 +916,10 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
       const Index faceContacts = resolveFaceContacts();
       report.faceContacts += faceContacts;
       contacts = contact.contacts + faceContacts;
+      m_colliderContacts = contacts;
     } else {
       m_faceContacts.clear();
+      m_colliderContacts = 0;
     }
     const bool selfCollisionNeeded =
         m_selfCollision && !(m_skipStages && m_foldCulling->cannotTouchItself(
@@ -925,7 +930,7 @@ HealthFailure Cloth::runSubsteps(Real t, Real frameDt, Index substeps,
     if (m_selfCollision && m_strainLimiter) {
       // The joint projection holds every self-contact (limitStrainInContact); otherwise only
       // a cloth of very different masses holds any.
-      m_selfCollision->setRecordSeparations(m_massesNeedSeparations || jointProjection(colliders));
+      m_selfCollision->setRecordSeparations(m_massesNeedSeparations || jointProjection());
     }
     if (selfCollisionNeeded) {
       const Index before = report.selfCollision.proximityContacts + report.selfCollision.impacts;

@@ -206,8 +206,9 @@ class Cloth final : public DynamicSystem {
   // and then the vertices out of every collider again; returns the face contacts.
   Index resolveFaceContacts();
   // Whether this substep's rounds in contact run the joint projection: the setting is on and
-  // colliders are near the cloth (m_nearColliders).
-  bool jointProjection(std::span<const ColliderFrame> colliders) const;
+  // the substep's first collider pass found vertices or faces in contact (a count that skipping
+  // stages does not change).
+  bool jointProjection() const;
   // One strain-limiter run in contact: joint, with every self-contact of the substep and the
   // collider contacts as constraints (ColliderProjection); otherwise with the collider contacts
   // held along their normals and the self-contacts of very different masses held.
@@ -296,6 +297,7 @@ class Cloth final : public DynamicSystem {
   std::vector<ColliderFrame> m_stillColliders;
   bool m_keepOutFromProjection = false;  // keepVerticesOutOfColliders: from m_projectedPositions
   bool m_massesNeedSeparations = false;  // masses spread beyond kHeldContactMassRatio
+  Index m_colliderContacts = 0;  // vertices and faces the substep's first collider pass met
   ClothStageCounters m_stages;                     // this frame's
   bool m_sleeping = false, m_wakeRequested = false;
   Index m_quietFrames = 0;

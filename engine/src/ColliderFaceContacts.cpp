@@ -274,8 +274,12 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
       const Pose& endPose = colliders[candidate.collider].end.pose;
       std::array<Vec3, 3> local;
       cornersInBody(candidate, local);
-      const int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0],
-                                   local[1], local[2], 0, points);
+      // Every contact point, shallow ones too, so that the list recomputed after a push below
+      // enumerates the same points in the same order (with only the deep ones kept, a push that
+      // made the first point shallow shifted the others down, and the loop skipped the last one:
+      // a face edge beside a rod stayed 0.12 mm inside the reach).
+      int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                             local[2], -std::numeric_limits<Real>::infinity(), points);
       bool pushed = false;
       for (int p = 0; p < count; ++p) {
         const FacePoint& point = points[p];
@@ -290,8 +294,8 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         // The next point of this face sees the face where this push left it.
         if (p + 1 < count) {
           cornersInBody(candidate, local);
-          (void)facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                           local[2], -std::numeric_limits<Real>::infinity(), points);
+          count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                             local[2], -std::numeric_limits<Real>::infinity(), points);
         }
       }
       if (pushed && !candidate.pushed) ++report.contacts;
@@ -351,8 +355,9 @@ Index ColliderFaceContacts::project(std::span<const ColliderFrame> colliders,
     const Pose& endPose = colliders[candidate.collider].end.pose;
     std::array<Vec3, 3> local;
     for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
-    const int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                                 local[2], 0, points);
+    // Every point, shallow ones too, as in resolve(): the recomputed list keeps its order.
+    int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                           local[2], -std::numeric_limits<Real>::infinity(), points);
     for (int p = 0; p < count; ++p) {
       const FacePoint& point = points[p];
       if (!(point.depth > 0)) continue;
@@ -369,8 +374,8 @@ Index ColliderFaceContacts::project(std::span<const ColliderFrame> colliders,
       // The next point of this face sees the face where this push left it.
       if (p + 1 < count) {
         for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
-        (void)facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                         local[2], -std::numeric_limits<Real>::infinity(), points);
+        count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                           local[2], -std::numeric_limits<Real>::infinity(), points);
       }
     }
   }

@@ -13,11 +13,13 @@ constexpr Real kViolationPerThickness = 0.01;
 
 void ColliderProjection::prepare(std::span<const ColliderFrame> colliders,
                                  const ColliderFaceContacts* faces,
+                                 std::span<const ColliderFrame> faceColliders,
                                  std::span<const TriangleRest> triangles,
                                  std::span<const Real> inverseMasses, Real thickness, Real margin,
                                  std::span<const Vec3> x) {
   m_colliders = colliders;
   m_faces = faces;
+  m_faceColliders = faceColliders;
   m_triangles = triangles;
   m_inverseMasses = inverseMasses;
   m_thickness = thickness;
@@ -43,7 +45,7 @@ Index ColliderProjection::project(std::span<Vec3> x, std::span<Vec3> v, Real inv
   const Real tolerance = kViolationPerThickness * m_thickness;
   Index violated = 0;
   if (m_faces) {
-    violated += m_faces->project(m_colliders, m_triangles, m_inverseMasses, inverseStep, tolerance,
+    violated += m_faces->project(m_faceColliders, m_triangles, m_inverseMasses, inverseStep, tolerance,
                                  x, v);
   }
   for (VertexContact& contact : m_vertexContacts) {

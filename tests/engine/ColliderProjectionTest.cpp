@@ -32,7 +32,7 @@ TEST(ColliderProjection, PutsAVertexInsideASphereOnItsThicknessAndMakesTheMoveAV
   // is far away and not constrained.
   Vec3Array x{Vec3(0, 0.102, 0), Vec3(1, 0, 0)}, v(2, Vec3::Zero());
   ColliderProjection projection;
-  projection.prepare(colliders, nullptr, {}, inverseMasses, kThickness, 0.02, x);
+  projection.prepare(colliders, nullptr, {}, {}, inverseMasses, kThickness, 0.02, x);
   x[0] = Vec3(0, 0.09, 0);
   EXPECT_EQ(projection.project(x, v, 1 / kStep), 1);
   EXPECT_NEAR(x[0].y(), 0.1 + kThickness, 1e-12);
@@ -53,7 +53,7 @@ TEST(ColliderProjection, AVertexPulledAcrossAThinCapsuleGoesBackToTheSideItCameF
   const std::vector<Real> inverseMasses{1};
   Vec3Array x{Vec3(0, 0.015, 0)}, v(1, Vec3::Zero());
   ColliderProjection projection;
-  projection.prepare(colliders, nullptr, {}, inverseMasses, kThickness, 0.02, x);
+  projection.prepare(colliders, nullptr, {}, {}, inverseMasses, kThickness, 0.02, x);
   x[0] = Vec3(0, -0.003, 0);
   (void)projection.project(x, v, 1 / kStep);
   EXPECT_GT(x[0].y(), 0.01 + kThickness - 1e-9) << "pushed out through the far side";
@@ -77,7 +77,7 @@ TEST(ColliderProjection, TheStrainLimiterSatisfiesItsEdgesAndTheCollidersTogethe
   const Vec3Array zeroNormals(2, Vec3::Zero());
   Vec3Array x{Vec3(-0.1, 1 + kThickness, 0), Vec3(0.1, 1 + kThickness, 0)}, v(2, Vec3::Zero());
   ColliderProjection projection;
-  projection.prepare(colliders, nullptr, {}, inverseMasses, kThickness, 0.05, x);
+  projection.prepare(colliders, nullptr, {}, {}, inverseMasses, kThickness, 0.05, x);
   x[1].y() -= 0.005;
   const StrainLimitReport report = limiter.applyInContact(settings, inverseMasses, zeroNormals,
                                                           kStep, x, v, tasks, {}, &projection);
