@@ -285,8 +285,8 @@ class Cloth final : public DynamicSystem {
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
   ColliderFaceContacts m_faceContacts;             // faces against the colliders, this pass
-  // The joint projection (limitStrainInContact with colliders near; ColliderProjection.h): its
-  // collider constraints, the self-contacts of every pass of the substep, zero contact normals
+  // The joint projection (limitStrainInContact in contact with colliders; ColliderProjection.h):
+  // its collider constraints, the self-contacts of every pass of the substep, zero normals
   // (no vertex held along a surface), its limiter settings, the positions it ended at and the
   // near colliders held at their end pose (the collider passes after a projection).
   ColliderProjection m_colliderProjection;

@@ -27,17 +27,18 @@
 // So one iteration of the limiter runs the edges, the self-contacts and the colliders, and it
 // stops only when none of them needs correcting (or at its iteration cap).
 //
-// How Cloth uses it (ClothSettings::jointContactProjection, limitStrainInContact, while colliders
-// are near): no vertex is held along a surface normal (the edges may lift it off); every
+// How Cloth uses it (ClothSettings::jointContactProjection, limitStrainInContact, in a substep
+// whose first collider pass found contacts): no vertex is held along a surface normal (the edges may lift it off); every
 // self-contact that any self-collision pass of the substep found is held at the separation that
 // pass left it at; after each projection the collider passes run from where it left the
 // vertices (not from the step start: the chord from there to a vertex carried round a body can
 // cut the body) and the self-collision pass runs; rounds of 256 iterations until one finds
-// nothing to correct, 12 at most, then a last projection, followed only by the collider passes.
+// nothing to correct, 24 at most, then a last projection, followed only by the collider passes.
 // Measured (stress scene 7, README row 7): each of these was needed for 0.101 and no crossing.
 // Known limit: the last projection can carry pairs that were not in contact past each other if
 // the rounds left much to correct (2 … 10 crossing pairs after 6 rounds of 64 iterations at
-// 16 × 16 vertices a layer); after 12 rounds of 256 none was seen.
+// 16 × 16 vertices a layer, 4 in one of four draws after 12 rounds of 256); after 24 rounds of
+// 256 none was seen.
 //
 // Which vertices: those within `thickness + margin` of a collider when the run starts
 // (prepare()); one iteration moves a vertex far less than the margin (Cloth: half an edge), and

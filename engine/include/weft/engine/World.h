@@ -97,7 +97,7 @@ struct ClothSettings {
   /// the vertices' and faces' collider contacts together (ColliderProjection) instead of one pass
   /// after the other. Keeps cloth jammed between bodies within the strain limit (three sheets
   /// pushed through a ring of capsules: 0.101 instead of 0.79 … 4.7); costs up to 4 times the
-  /// limiter's iterations and twice its rounds in such substeps (the curtain: p50 about 2 %).
+  /// limiter's iterations and rounds in such substeps (the curtain: p50 about 2 %).
   /// Off: the former sequential rounds, collider contacts held along their normals.
   bool jointContactProjection = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
