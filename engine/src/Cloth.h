@@ -7,6 +7,7 @@
 
 #include "ClothForces.h"
 #include "ColliderFaceContacts.h"
+#include "ColliderProjection.h"
 #include "ColliderResponse.h"
 #include "FoldCulling.h"
 #include "RigidFit.h"
@@ -211,6 +212,18 @@ class Cloth final : public DynamicSystem {
   // pass left on a body (its holds), so that the solve does not sink them into it (see
   // constrainContacts). Vertices already constrained keep their constraint.
   void constrainFaceCorners(const Vec3Array& x, const Vec3Array& v, Real h, VertexFilter& filter);
+  // Whether this substep's rounds in contact run the joint projection: the setting is on, the
+  // substep's first collider pass found vertices or faces in contact and its first self-collision
+  // pass self-contacts (counts that skipping stages does not change).
+  bool jointProjection() const;
+  // One strain-limiter run in contact: joint, with every self-contact of the substep and the
+  // collider contacts as constraints (ColliderProjection); otherwise with the collider contacts
+  // held along their normals and the self-contacts of very different masses held.
+  StrainLimitReport projectInContact(Real h, bool selfCollision, bool joint,
+                                     const StrainLimitSettings& settings);
+  // After a joint projection: vertices, then faces, out of the colliders, each vertex followed
+  // from where the projection left it, the bodies at their end pose.
+  void keepOutOfCollidersAfterProjection(std::span<ColliderFrame> colliders);
   // The collider response's keep-out pass over m_nearColliders, without friction, updating the
   // contact holds (the limiter's rounds, and after a face pass).
   void keepVerticesOutOfColliders();
@@ -279,6 +292,20 @@ class Cloth final : public DynamicSystem {
   bool m_skipStages = true;                        // WorldSettings::skipUnneededStages
   std::vector<ColliderFrame> m_nearColliders;      // this pass's colliders near the cloth
   ColliderFaceContacts m_faceContacts;             // faces against the colliders, this pass
+  // The joint projection (limitStrainInContact in contact with colliders; ColliderProjection.h):
+  // its collider constraints, the self-contacts of every pass of the substep, zero normals
+  // (no vertex held along a surface), its limiter settings, the positions it ended at and the
+  // near colliders held at their end pose (the collider passes after a projection).
+  ColliderProjection m_colliderProjection;
+  std::vector<SeparationHold> m_substepSelfHolds;
+  Vec3Array m_freeContactNormals;
+  StrainLimitSettings m_jointLimitSettings;
+  Vec3Array m_projectedPositions;
+  std::vector<ColliderFrame> m_stillColliders;
+  bool m_keepOutFromProjection = false;  // keepVerticesOutOfColliders: from m_projectedPositions
+  bool m_massesNeedSeparations = false;  // masses spread beyond kHeldContactMassRatio
+  Index m_colliderContacts = 0;  // vertices and faces the substep's first collider pass met
+  Index m_substepSelfContacts = 0;  // self-contacts the substep's first self-collision pass met
   ClothStageCounters m_stages;                     // this frame's
   bool m_sleeping = false, m_wakeRequested = false;
   Index m_quietFrames = 0;

@@ -187,7 +187,7 @@ Real pointInverseMass(const Vec3& b, const std::array<Index, 3>& corner,
 // velocities): corner k by b_k w_k / weight · amount · direction, weight = pointInverseMass.
 void moveFacePoint(const Vec3& b, const std::array<Index, 3>& corner,
                    std::span<const Real> inverseMasses, Real weight, Real amount,
-                   const Vec3& direction, Vec3Array& values) {
+                   const Vec3& direction, std::span<Vec3> values) {
   for (int j = 0; j < 3; ++j) {
     values[corner[j]] += (b[j] * inverseMasses[corner[j]] / weight * amount) * direction;
   }
@@ -302,8 +302,12 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
         const Pose& endPose = colliders[candidate.collider].end.pose;
         std::array<Vec3, 3> local;
         cornersInBody(candidate, local);
-        int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0],
-                               local[1], local[2], 0, points);
+        // Every contact point, shallow ones too, so that the list recomputed after a push below
+        // enumerates the same points in the same order (with only the deep ones kept, a push
+        // that made the first point shallow shifted the others down, and the loop skipped the
+        // last one: a face edge beside a rod stayed 0.12 mm inside the reach).
+        int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                               local[2], -std::numeric_limits<Real>::infinity(), points);
         bool pushed = false;
         for (int p = 0; p < count; ++p) {
           const FacePoint& point = points[p];
@@ -407,6 +411,44 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
   m_frictionCorners.clear();
   m_frictionVertices.clear();
   return report;
+}
+
+Index ColliderFaceContacts::project(std::span<const ColliderFrame> colliders,
+                                    std::span<const TriangleRest> triangles,
+                                    std::span<const Real> inverseMasses, Real inverseStep,
+                                    Real tolerance, std::span<Vec3> x, std::span<Vec3> v) const {
+  Index violated = 0;
+  std::array<FacePoint, 3> points;
+  for (const Candidate& candidate : m_candidates) {
+    const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
+    const Pose& endPose = colliders[candidate.collider].end.pose;
+    std::array<Vec3, 3> local;
+    for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
+    // Every point, shallow ones too, as in resolve(): the recomputed list keeps its order.
+    int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                           local[2], -std::numeric_limits<Real>::infinity(), points);
+    for (int p = 0; p < count; ++p) {
+      const FacePoint& point = points[p];
+      if (!(point.depth > 0)) continue;
+      const Vec3& b = point.barycentric;
+      const Real weight = pointInverseMass(b, corner, inverseMasses);
+      if (!(weight > 0)) continue;
+      const Vec3 normal = endPose.directionToWorld(point.normal);
+      for (int j = 0; j < 3; ++j) {
+        const Vec3 shift = (b[j] * inverseMasses[corner[j]] / weight * point.depth) * normal;
+        x[corner[j]] += shift;
+        v[corner[j]] += inverseStep * shift;
+      }
+      violated += point.depth > tolerance;
+      // The next point of this face sees the face where this push left it.
+      if (p + 1 < count) {
+        for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
+        count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
+                           local[2], -std::numeric_limits<Real>::infinity(), points);
+      }
+    }
+  }
+  return violated;
 }
 
 }  // namespace weft

@@ -139,6 +139,15 @@ class ColliderFaceContacts {
                              Vec3Array& v, bool friction = false, Real positionStep = 0,
                              std::span<const Real> solveImpulses = {});
 
+  /// One sweep over the face–core pairs the last resolve() found (same `colliders` and
+  /// `triangles`) at the current x: each face point short of its reach is moved back to it as
+  /// resolve() does, the move also made as the velocity change Δx · inverseStep. Returns how many
+  /// face points were deeper than `tolerance` (m). For the strain limiter's joint iteration
+  /// (ColliderProjection); finds no new pair.
+  Index project(std::span<const ColliderFrame> colliders, std::span<const TriangleRest> triangles,
+                std::span<const Real> inverseMasses, Real inverseStep, Real tolerance,
+                std::span<Vec3> x, std::span<Vec3> v) const;
+
   /// The contacts of the last resolve() as one-sided holds for the strain limiter.
   std::span<const SeparationHold> holds() const { return m_holds; }
 

@@ -87,7 +87,7 @@ StrainLimiter::StrainLimiter(std::span<const Edge> edges, Index vertexCount) {
 StrainLimitReport StrainLimiter::apply(const StrainLimitSettings& settings,
                                        std::span<const Real> inverseMasses, Real h,
                                        std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
-  return run(settings, inverseMasses, {}, {}, h, x, v, tasks);
+  return run(settings, inverseMasses, {}, {}, nullptr, h, x, v, tasks);
 }
 
 StrainLimitReport StrainLimiter::applyInContact(const StrainLimitSettings& settings,
@@ -95,10 +95,11 @@ StrainLimitReport StrainLimiter::applyInContact(const StrainLimitSettings& setti
                                                 std::span<const Vec3> contactNormals, Real h,
                                                 std::span<Vec3> x, std::span<Vec3> v,
                                                 TaskSystem& tasks,
-                                                std::span<const SeparationHold> separations) {
+                                                std::span<const SeparationHold> separations,
+                                                PositionConstraints* constraints) {
   assert(contactNormals.size() == m_correctionCount.size() &&
          "StrainLimiter::applyInContact: one contact normal (zero: none) per vertex");
-  return run(settings, inverseMasses, contactNormals, separations, h, x, v, tasks);
+  return run(settings, inverseMasses, contactNormals, separations, constraints, h, x, v, tasks);
 }
 
 void StrainLimiter::separate(std::span<const SeparationHold> separations,
@@ -188,8 +189,9 @@ void StrainLimiter::sweep(Real stretchFactor, std::span<const Real> inverseMasse
 StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
                                      std::span<const Real> inverseMasses,
                                      std::span<const Vec3> contactNormals,
-                                     std::span<const SeparationHold> separations, Real h,
-                                     std::span<Vec3> x, std::span<Vec3> v, TaskSystem& tasks) {
+                                     std::span<const SeparationHold> separations,
+                                     PositionConstraints* constraints, Real h, std::span<Vec3> x,
+                                     std::span<Vec3> v, TaskSystem& tasks) {
   const Index vertexCount = Index(m_correctionCount.size());
   assert(x.size() == vertexCount && v.size() == vertexCount && inverseMasses.size() == vertexCount &&
          "StrainLimiter::apply: one position, velocity and inverse mass per vertex");
@@ -205,6 +207,10 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
   const bool jacobi = settings.order != StrainLimitOrder::GaussSeidel;
 
   StrainLimitReport report;
+  // The further constraints are projected first (the collision passes before this run may have
+  // left some violated) and after every iteration; `violated` counts those the last projection
+  // found violated, and the run goes on until neither they nor the edges need correcting.
+  Index violated = constraints ? constraints->project(x, v, inverseStep) : 0;
   for (int iteration = 0;; ++iteration) {
     // 1. Per edge: the impulse that brings it back to the limit, and the count of edges that
     //    are still over limit + tolerance (the stopping test).
@@ -246,12 +252,13 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
         },
         sum);
     report.edgesOverLimit = over;
-    if (over == 0 || iteration == settings.maxIterations) break;
+    if ((over == 0 && violated == 0) || iteration == settings.maxIterations) break;
     report.iterations = iteration + 1;
 
     if (!jacobi) {
       sweep(stretchFactor, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
       separate(separations, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
+      if (constraints) violated = constraints->project(x, v, inverseStep);
       continue;
     }
 
@@ -295,6 +302,7 @@ StrainLimitReport StrainLimiter::run(const StrainLimitSettings& settings,
     });
     // The self-contacts after the edges, serially (they are few): the same for any thread count.
     separate(separations, inverseMasses, contactNormals, inverseStep, iteration % 2 == 1, x, v);
+    if (constraints) violated = constraints->project(x, v, inverseStep);
   }
   return report;
 }

@@ -93,7 +93,9 @@
 // in contact and the collisions again, a few rounds: collisions keep the last word (nothing
 // inside a collider, no crossing) even where that costs a little strain. Between features of
 // comparable masses the self-collision pass after the last round can still stretch the cloth
-// (jammed layers, stress scene 7).
+// (jammed layers, stress scene 7); ClothSettings::jointContactProjection then runs the limiter
+// with every self-contact and the collider contacts as constraints (PositionConstraints,
+// ColliderProjection.h), rounds until they settle.
 #pragma once
 
 #include <weft/Math.h>
@@ -136,6 +138,19 @@ inline bool spansHeldMassRatio(const SeparationHold& pair, std::span<const Real>
   }
   return lightest > kHeldContactMassRatio * heaviest;
 }
+
+/// Further one-sided constraints on positions that StrainLimiter::applyInContact satisfies together
+/// with its edges and separations (Gauss–Seidel): Cloth's collider contacts (ColliderProjection).
+class PositionConstraints {
+ public:
+  /// One pass over every constraint at the current x: each violated one is projected back onto
+  /// its bound, each position change Δx made also as the velocity change Δx · inverseStep.
+  /// Returns how many were violated by more than the implementation's tolerance.
+  virtual Index project(std::span<Vec3> x, std::span<Vec3> v, Real inverseStep) = 0;
+
+ protected:
+  ~PositionConstraints() = default;
+};
 
 /// How the strain limiter orders its corrections within one iteration.
 enum class StrainLimitOrder {
@@ -194,12 +209,14 @@ class StrainLimiter {
                                    std::span<const Real> inverseMasses,
                                    std::span<const Vec3> contactNormals, Real h, std::span<Vec3> x,
                                    std::span<Vec3> v, TaskSystem& tasks,
-                                   std::span<const SeparationHold> separations = {});
+                                   std::span<const SeparationHold> separations = {},
+                                   PositionConstraints* constraints = nullptr);
 
  private:
   StrainLimitReport run(const StrainLimitSettings& settings, std::span<const Real> inverseMasses,
                         std::span<const Vec3> contactNormals,
-                        std::span<const SeparationHold> separations, Real h, std::span<Vec3> x,
+                        std::span<const SeparationHold> separations,
+                        PositionConstraints* constraints, Real h, std::span<Vec3> x,
                         std::span<Vec3> v, TaskSystem& tasks);
 
   // One Gauss–Seidel pass over every edge over the limit, forward or backward in edge order.
