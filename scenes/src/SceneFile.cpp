@@ -529,8 +529,8 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
   if (!reader.expectObject(object, path, "a cloth")) return std::nullopt;
   reader.checkKeys(object, path,
                    {"name", "grid", "mesh", "translation", "rotation", "forceModel", "material",
-                    "springs", "solver", "selfCollision", "faceContacts", "initialPleats",
-                    "pins"});
+                    "springs", "solver", "selfCollision", "faceContacts", "jointContactProjection",
+                    "initialPleats", "pins"});
   ClothDescription cloth;
   cloth.name = "cloth " + std::to_string(index);
   reader.readString(object, path, "name", cloth.name);
@@ -587,6 +587,7 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
   if (const Json* solver = Reader::member(object, "solver")) readSolver(reader, *solver, child(path, "solver"), settings.solver);
   reader.readBool(object, path, "selfCollision", settings.selfCollision);
   reader.readBool(object, path, "faceContacts", settings.faceContacts);
+  reader.readBool(object, path, "jointContactProjection", settings.jointContactProjection);
 
   if (const Json* pleats = Reader::member(object, "initialPleats")) {
     const std::string here = child(path, "initialPleats");
