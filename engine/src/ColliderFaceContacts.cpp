@@ -193,6 +193,47 @@ void moveFacePoint(const Vec3& b, const std::array<Index, 3>& corner,
   }
 }
 
+// Pushes each point where the face of `corner` is short of its reach from `core` out to it, one
+// after the other, each seeing the face where the last push left it (x; the body posed at
+// `endPose`); with inverseStep > 0 each shift Δx is made as the velocity change Δx · inverseStep
+// in `v` too. Every contact point is listed, shallow ones too, so that the list recomputed after
+// a push enumerates the same points in the same order (with only the deep ones kept, a push that
+// made the first point shallow shifted the others down, and the loop skipped the last one: a
+// face edge beside a rod stayed 0.12 mm inside the reach). Returns how many points were deeper
+// than `counted` (m); `pushed` is set when a point moved.
+int pushFaceOut(const FaceCore& core, const Vec3& cameFrom, const Pose& endPose,
+                const std::array<Index, 3>& corner, std::span<const Real> inverseMasses,
+                Real counted, std::span<Vec3> x, std::span<Vec3> v, Real inverseStep,
+                bool& pushed) {
+  std::array<FacePoint, 3> points;
+  std::array<Vec3, 3> local;
+  const auto findPoints = [&] {
+    for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
+    return facePoints(core, cameFrom, local[0], local[1], local[2],
+                      -std::numeric_limits<Real>::infinity(), points);
+  };
+  int deep = 0;
+  int count = findPoints();
+  for (int p = 0; p < count; ++p) {
+    const FacePoint& point = points[p];
+    if (!(point.depth > 0)) continue;
+    const Vec3& b = point.barycentric;
+    const Real weight = pointInverseMass(b, corner, inverseMasses);
+    if (!(weight > 0)) continue;
+    const Vec3 normal = endPose.directionToWorld(point.normal);
+    for (int j = 0; j < 3; ++j) {
+      // moveFacePoint's distribution, by the depth along the normal.
+      const Vec3 shift = (b[j] * inverseMasses[corner[j]] / weight * point.depth) * normal;
+      x[corner[j]] += shift;
+      if (inverseStep > 0) v[corner[j]] += inverseStep * shift;
+    }
+    pushed = true;
+    deep += point.depth > counted;
+    if (p + 1 < count) count = findPoints();
+  }
+  return deep;
+}
+
 }  // namespace
 
 ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> colliders,
@@ -298,34 +339,12 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
       ++report.sweeps;
       bool moved = false;
       for (Candidate& candidate : m_candidates) {
-        const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
-        const Pose& endPose = colliders[candidate.collider].end.pose;
-        std::array<Vec3, 3> local;
-        cornersInBody(candidate, local);
-        // Every contact point, shallow ones too, so that the list recomputed after a push below
-        // enumerates the same points in the same order (with only the deep ones kept, a push
-        // that made the first point shallow shifted the others down, and the loop skipped the
-        // last one: a face edge beside a rod stayed 0.12 mm inside the reach).
-        int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                               local[2], -std::numeric_limits<Real>::infinity(), points);
         bool pushed = false;
-        for (int p = 0; p < count; ++p) {
-          const FacePoint& point = points[p];
-          if (!(point.depth > 0)) continue;
-          const Vec3& b = point.barycentric;
-          const Real weight = pointInverseMass(b, corner, inverseMasses);
-          if (!(weight > 0)) continue;
-          moveFacePoint(b, corner, inverseMasses, weight, point.depth,
-                        endPose.directionToWorld(point.normal), x);
-          pushed = true;
-          moved = moved || point.depth > kSettledDepth;
-          // The next point of this face sees the face where this push left it.
-          if (p + 1 < count) {
-            cornersInBody(candidate, local);
-            count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                               local[2], -std::numeric_limits<Real>::infinity(), points);
-          }
-        }
+        const int deep = pushFaceOut(m_cores[candidate.core], candidate.cameFrom,
+                                     colliders[candidate.collider].end.pose,
+                                     triangles[candidate.triangle].vertices, inverseMasses,
+                                     kSettledDepth, x, {}, 0, pushed);
+        moved = moved || deep > 0;
         if (pushed && !candidate.pushed) ++report.contacts;
         candidate.pushed = candidate.pushed || pushed;
       }
@@ -418,35 +437,12 @@ Index ColliderFaceContacts::project(std::span<const ColliderFrame> colliders,
                                     std::span<const Real> inverseMasses, Real inverseStep,
                                     Real tolerance, std::span<Vec3> x, std::span<Vec3> v) const {
   Index violated = 0;
-  std::array<FacePoint, 3> points;
   for (const Candidate& candidate : m_candidates) {
-    const std::array<Index, 3>& corner = triangles[candidate.triangle].vertices;
-    const Pose& endPose = colliders[candidate.collider].end.pose;
-    std::array<Vec3, 3> local;
-    for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
-    // Every point, shallow ones too, as in resolve(): the recomputed list keeps its order.
-    int count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                           local[2], -std::numeric_limits<Real>::infinity(), points);
-    for (int p = 0; p < count; ++p) {
-      const FacePoint& point = points[p];
-      if (!(point.depth > 0)) continue;
-      const Vec3& b = point.barycentric;
-      const Real weight = pointInverseMass(b, corner, inverseMasses);
-      if (!(weight > 0)) continue;
-      const Vec3 normal = endPose.directionToWorld(point.normal);
-      for (int j = 0; j < 3; ++j) {
-        const Vec3 shift = (b[j] * inverseMasses[corner[j]] / weight * point.depth) * normal;
-        x[corner[j]] += shift;
-        v[corner[j]] += inverseStep * shift;
-      }
-      violated += point.depth > tolerance;
-      // The next point of this face sees the face where this push left it.
-      if (p + 1 < count) {
-        for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
-        count = facePoints(m_cores[candidate.core], candidate.cameFrom, local[0], local[1],
-                           local[2], -std::numeric_limits<Real>::infinity(), points);
-      }
-    }
+    bool pushed = false;
+    violated += pushFaceOut(m_cores[candidate.core], candidate.cameFrom,
+                            colliders[candidate.collider].end.pose,
+                            triangles[candidate.triangle].vertices, inverseMasses, tolerance, x,
+                            v, inverseStep, pushed);
   }
   return violated;
 }
