@@ -660,21 +660,18 @@ void Cloth::constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
     }
   }
   selectNearColliders(m_colliders, predicted, &start);
-  if (m_freeVertexMap.isIdentity()) {
-    // The face corners first: ColliderResponse frees only the vertices it constrained itself.
-    for (Index corner : m_faceConstrainedCorners) filter.setFree(corner);
-    m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
-                                 m_pinnedMask, filter);
-    constrainFaceCorners(x, v, h, filter);
-    return;
-  }
-  // Pins are removed from the solve: gather the contacts by vertex, then copy them (bit for bit)
-  // into the rows of the solve's filter. Pinned vertices are never constrained, so every
-  // constrained vertex has a row.
-  for (Index corner : m_faceConstrainedCorners) m_contactFilter.setFree(corner);
+  // The contacts are gathered by vertex: straight into the solve's filter when its rows are the
+  // vertices; else, pins being removed from the solve, into m_contactFilter and then copied (bit
+  // for bit) into the rows. Pinned vertices are never constrained, so every constrained vertex
+  // has a row.
+  const bool rowsAreVertices = m_freeVertexMap.isIdentity();
+  VertexFilter& byVertex = rowsAreVertices ? filter : m_contactFilter;
+  // The face corners first: ColliderResponse frees only the vertices it constrained itself.
+  for (Index corner : m_faceConstrainedCorners) byVertex.setFree(corner);
   m_colliderResponse.constrain(m_nearColliders, x, v, h, m_settings.material.thickness,
-                               m_pinnedMask, m_contactFilter);
-  constrainFaceCorners(x, v, h, m_contactFilter);
+                               m_pinnedMask, byVertex);
+  constrainFaceCorners(x, v, h, byVertex);
+  if (rowsAreVertices) return;
   for (Index row : m_contactRows) filter.setFree(row);
   m_contactRows.clear();
   if (m_contactFilter.constrainedVertexCount() == 0) return;
@@ -712,7 +709,8 @@ void Cloth::constrainFaceCorners(const Vec3Array& x, const Vec3Array& v, Real h,
     const Real speed = -gap / h;  // m/s along the normal that ends the step at the reach
     for (int k = 0; k < 3; ++k) {
       const Index corner = hold.vertices[k];
-      if (!(hold.weights[k] > 0) || m_pinnedMask[corner] || filter.kind(corner) != ConstraintKind::Free) {
+      if (!(hold.weights[k] > 0) || m_pinnedMask[corner] ||
+          filter.kind(corner) != ConstraintKind::Free) {
         continue;
       }
       filter.setConstrained(corner, hold.normal,
@@ -764,6 +762,8 @@ Index Cloth::resolveFaceContacts(Real frictionStep) {
 void Cloth::keepVerticesOutOfColliders() {
   // Without friction, which the substep's first pass took; with the holds, so that a vertex put
   // on a surface is held there.
+  std::span<const ColliderFrame> colliders = m_nearColliders;
+  const Vec3Array* from = &m_stepStartPositions;
   if (m_keepOutFromProjection) {
     // After a joint projection (limitStrainInContact): the paths from where the projection
     // left each vertex, the bodies held at their end pose. The first pass already followed each
@@ -774,14 +774,10 @@ void Cloth::keepVerticesOutOfColliders() {
     // 0.40 right after a projection that left 0.101).
     m_stillColliders.assign(m_nearColliders.begin(), m_nearColliders.end());
     for (ColliderFrame& collider : m_stillColliders) collider.start = collider.end;
-    (void)m_colliderResponse.resolve(m_stillColliders, m_projectedPositions,
-                                     m_stepStartVelocities, m_settings.material.thickness,
-                                     m_pinnedMask, m_positions, m_velocities,
-                                     m_strainLimiter ? &m_contactHolds : nullptr,
-                                     /*friction=*/false);
-    return;
+    colliders = m_stillColliders;
+    from = &m_projectedPositions;
   }
-  (void)m_colliderResponse.resolve(m_nearColliders, m_stepStartPositions, m_stepStartVelocities,
+  (void)m_colliderResponse.resolve(colliders, *from, m_stepStartVelocities,
                                    m_settings.material.thickness, m_pinnedMask, m_positions,
                                    m_velocities, m_strainLimiter ? &m_contactHolds : nullptr,
                                    /*friction=*/false);

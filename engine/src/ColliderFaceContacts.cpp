@@ -403,9 +403,8 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
           // Its solve impulse is the face constraint's (Cloth::constrainFaceCorners).
           const Real solvePart = solveImpulses.empty() ? 0 : std::max<Real>(0, solveImpulses[i]);
           m_cornerSlot[i] = Index(m_frictionCorners.size());
-          m_frictionCorners.push_back({normal, body.velocityAt(x[i]),
+          m_frictionCorners.push_back({i, normal, body.velocityAt(x[i]),
                                        colliders[candidate.collider].friction, solvePart});
-          m_frictionVertices.push_back(i);
         }
         // The corner's share of the push just made (moveFacePoint's).
         m_frictionCorners[m_cornerSlot[i]].normalChange -=
@@ -413,9 +412,8 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
       }
     }
   }
-  for (std::size_t k = 0; k < m_frictionCorners.size(); ++k) {
-    const Index i = m_frictionVertices[k];
-    const FrictionCorner& contact = m_frictionCorners[k];
+  for (const FrictionCorner& contact : m_frictionCorners) {
+    const Index i = contact.vertex;
     m_cornerSlot[i] = kInvalidIndex;
     const Vec3 relative = v[i] - contact.bodyVelocity;
     const Vec3 tangential = relative - relative.dot(contact.normal) * contact.normal;
@@ -428,7 +426,6 @@ ColliderFaceReport ColliderFaceContacts::resolve(std::span<const ColliderFrame> 
   // a curved body (4.1 mm into the test's rod without this): the faces are put back out.
   if (positionStep > 0 && !m_frictionCorners.empty()) sweepOut();
   m_frictionCorners.clear();
-  m_frictionVertices.clear();
   return report;
 }
 

@@ -170,6 +170,7 @@ class ColliderFaceContacts {
   std::vector<SeparationHold> m_holds;
   // Friction is taken at the corners of the touching faces, each corner once (see the note).
   struct FrictionCorner {
+    Index vertex = 0;
     Vec3 normal = Vec3::Zero();        // of its first touching face point
     Vec3 bodyVelocity = Vec3::Zero();  // of that body at the corner
     Real friction = 0;                 // that body's coefficient
@@ -177,7 +178,6 @@ class ColliderFaceContacts {
   };
   std::vector<Index> m_cornerSlot;  // by vertex: into m_frictionCorners, or kInvalidIndex
   std::vector<FrictionCorner> m_frictionCorners;
-  std::vector<Index> m_frictionVertices;        // the vertex of each m_frictionCorners entry
 };
 
 }  // namespace weft
