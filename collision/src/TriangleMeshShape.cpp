@@ -80,26 +80,27 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
 
   TriangleMeshShape shape;
   if (Status status = shape.setMotion(motion); !status) return status.error();
-  shape.m_localVertices.assign(localVertices.begin(), localVertices.end());
-  shape.m_indices.assign(indices.begin(), indices.end());
-  Result<Bvh> tree = Bvh::build(shape.m_indices, shape.m_localVertices);
+  auto geometry = std::make_shared<Geometry>();
+  geometry->vertices.assign(localVertices.begin(), localVertices.end());
+  geometry->indices.assign(indices.begin(), indices.end());
+  Result<Bvh> tree = Bvh::build(geometry->indices, geometry->vertices);
   if (!tree) return tree.error();
-  shape.m_localBvh = std::move(tree).value();
+  geometry->bvh = std::move(tree).value();
 
   // Face normals, angle-weighted vertex normals.
-  const auto& x = shape.m_localVertices;
-  shape.m_faceNormals.resize(triangleCount);
-  shape.m_vertexNormals.assign(x.size(), Vec3::Zero());
+  const auto& x = geometry->vertices;
+  geometry->faceNormals.resize(triangleCount);
+  geometry->vertexNormals.assign(x.size(), Vec3::Zero());
   for (Index t = 0; t < triangleCount; ++t) {
     const Index corner[3] = {indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]};
     const Vec3 normal = (x[corner[1]] - x[corner[0]]).cross(x[corner[2]] - x[corner[0]]).normalized();
-    shape.m_faceNormals[t] = normal;
+    geometry->faceNormals[t] = normal;
     for (int k = 0; k < 3; ++k) {
       const Real angle = cornerAngle(x[corner[k]], x[corner[(k + 1) % 3]], x[corner[(k + 2) % 3]]);
-      shape.m_vertexNormals[corner[k]] += angle * normal;
+      geometry->vertexNormals[corner[k]] += angle * normal;
     }
   }
-  for (Vec3& n : shape.m_vertexNormals) {
+  for (Vec3& n : geometry->vertexNormals) {
     if (n.squaredNorm() > 0) n.normalize();
   }
 
@@ -114,24 +115,26 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
     }
   }
   std::sort(edgeSlots.begin(), edgeSlots.end());
-  shape.m_edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
+  geometry->edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
   for (std::size_t begin = 0; begin < edgeSlots.size();) {
     std::size_t end = begin;
     Vec3 sum = Vec3::Zero();
     while (end < edgeSlots.size() && edgeSlots[end].first == edgeSlots[begin].first) {
-      sum += shape.m_faceNormals[edgeSlots[end].second / 3];
+      sum += geometry->faceNormals[edgeSlots[end].second / 3];
       ++end;
     }
     if (sum.squaredNorm() > 0) sum.normalize();
-    for (std::size_t i = begin; i < end; ++i) shape.m_edgeNormals[edgeSlots[i].second] = sum;
+    for (std::size_t i = begin; i < end; ++i) geometry->edgeNormals[edgeSlots[i].second] = sum;
     begin = end;
   }
+  shape.m_geometry = std::move(geometry);
   return shape;
 }
 
 void TriangleMeshShape::worldVertices(std::span<Vec3> vertices) const {
-  for (std::size_t v = 0; v < m_localVertices.size() && v < vertices.size(); ++v) {
-    vertices[v] = m_motion.pose.toWorld(m_localVertices[v]);
+  const std::vector<Vec3>& local = m_geometry->vertices;
+  for (std::size_t v = 0; v < local.size() && v < vertices.size(); ++v) {
+    vertices[v] = m_motion.pose.toWorld(local[v]);
   }
 }
 
@@ -144,7 +147,8 @@ Status TriangleMeshShape::setMotion(const RigidMotion& motion) {
 
 ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
   const Vec3 local = m_motion.pose.toLocal(point);
-  const std::vector<Bvh::Node>& nodes = m_localBvh.nodes();
+  const Geometry& mesh = *m_geometry;
+  const std::vector<Bvh::Node>& nodes = mesh.bvh.nodes();
 
   // Best-first descent with a fixed stack (one pending sibling per level).
   Real bestSquared = std::numeric_limits<Real>::infinity();
@@ -157,10 +161,10 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
     const Bvh::Node& node = nodes[stack[--top]];
     if (node.bounds.squaredDistanceTo(local) >= bestSquared) continue;
     if (node.isLeaf()) {
-      for (Index t : m_localBvh.leafTriangles(node)) {
+      for (Index t : mesh.bvh.leafTriangles(node)) {
         const TriangleClosestPoint candidate = closestPointOnTriangle(
-            local, m_localVertices[m_indices[3 * t]], m_localVertices[m_indices[3 * t + 1]],
-            m_localVertices[m_indices[3 * t + 2]]);
+            local, mesh.vertices[mesh.indices[3 * t]], mesh.vertices[mesh.indices[3 * t + 1]],
+            mesh.vertices[mesh.indices[3 * t + 2]]);
         const Real squared = candidate.distance * candidate.distance;
         // Strictly closer only: among equal distances the first one found (a fixed order) wins.
         if (squared < bestSquared) {
@@ -185,15 +189,15 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
 
   // Pseudo-normal of the closest feature: vertex (one weight is 1), edge (one weight is 0), face.
   const Vec3& w = best.barycentric;
-  Vec3 pseudoNormal = m_faceNormals[bestTriangle];
+  Vec3 pseudoNormal = mesh.faceNormals[bestTriangle];
   for (Index k = 0; k < 3; ++k) {
     if (w[k] == 1) {
-      pseudoNormal = m_vertexNormals[m_indices[3 * bestTriangle + k]];
+      pseudoNormal = mesh.vertexNormals[mesh.indices[3 * bestTriangle + k]];
       break;
     }
     if (w[k] == 0) {
       // The edge opposite corner k runs from corner k+1 to corner k+2: edge slot (k + 1) % 3.
-      pseudoNormal = m_edgeNormals[3 * bestTriangle + (k + 1) % 3];
+      pseudoNormal = mesh.edgeNormals[3 * bestTriangle + (k + 1) % 3];
     }
   }
   const Vec3 offset = local - best.point;
@@ -203,7 +207,7 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
 }
 
 Aabb TriangleMeshShape::bounds() const {
-  const Aabb local = m_localBvh.bounds();
+  const Aabb local = m_geometry->bvh.bounds();
   Aabb box;
   for (int corner = 0; corner < 8; ++corner) {
     const Vec3 x((corner & 1) ? local.max.x() : local.min.x(),

@@ -2,7 +2,7 @@
 
 #include "Cloth.h"
 #include "FrameCostModel.h"
-#include "ClothClothCollision.h"
+#include "SubstepPipeline.h"
 
 #include <weft/threading/Profiler.h>
 
@@ -97,7 +97,7 @@ World::World(const WorldSettings& settings)
     m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{std::max(0, settings.threadCount)});
     m_tasks = m_ownedTasks.get();
   }
-  m_clothContact = std::make_unique<ClothClothCollision>(m_tasks);
+  m_pipeline = std::make_unique<SubstepPipeline>(m_tasks, settings.skipUnneededStages);
 }
 
 int World::threadCount() const { return m_tasks->threadCount(); }
@@ -426,59 +426,24 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
   stats.frame = m_stats.frame + 1;
   stats.plan = plan;
   stats.budgetMs = budgetMs;
-  Index totalSubsteps = 0;
-  // Where the colliders are at the frame start; each cloth steps against them from there (a
-  // cloth poses the shapes per substep), and they end the frame advanced by their velocities.
-  m_colliderStartMotions.clear();
-  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (collider->shape) m_colliderStartMotions.push_back(motion(*collider->shape));
-  }
   updateAttachedPins(frameDt);
-  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-    if (!slot->cloth) continue;
-    Cloth& cloth = *slot->cloth;
-    gatherColliderFrames(/*untilNow=*/false);
-    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames, plan);
-    stats.sleepingCloths += report.sleeping;
-    stats.wokenCloths += report.woke;
-    stats.teleportedCloths += report.teleported;
-    stats.colliderNarrowPhases += report.stages.colliderNarrowPhases;
-    stats.colliderNarrowPhasesSkipped += report.stages.colliderNarrowPhasesSkipped;
-    stats.selfCollisionPasses += report.stages.selfCollisionPasses;
-    stats.selfCollisionSkipped += report.stages.selfCollisionSkipped;
-    stats.bendingAssemblies += report.stages.bendingAssemblies;
-    stats.dampingJacobians += report.stages.dampingJacobians;
-    stats.bvhNodesRefit += report.stages.bvhNodesRefit;
-    stats.bvhNodesSkipped += report.stages.bvhNodesSkipped;
-    stats.frozenVertices += report.selfCollision.frozenVertices;
-    stats.strainLimitIterations += report.strainLimit.iterations;
-    stats.strainLimitEdgesOver += report.strainLimit.edgesOverLimit;
-    totalSubsteps += report.substeps;
-    stats.contacts += report.contacts;
-    stats.faceContacts += report.faceContacts;
-    stats.selfContacts += report.selfCollision.proximityContacts;
-    stats.selfImpacts += report.selfCollision.impacts;
-    stats.impactZones += report.selfCollision.impactZones;
-    stats.status |= report.status;
-    if (stats.healthFailure == HealthFailure::None) stats.healthFailure = report.healthFailure;
-    stats.substeps = std::max(stats.substeps, report.substeps);
-    stats.linearSolves += report.integrator.linearSolves;
-    stats.cgIterations += report.integrator.cgIterations;
-    stats.cgResidual = std::max(stats.cgResidual, report.integrator.cgResidual);
-    stats.potentialEnergy += report.integrator.potentialEnergy;
-    stats.assemblyMs += report.integrator.assemblyMs;
-    stats.solveMs += report.integrator.solveMs;
-    stats.solvedUnknowns += report.integrator.solvedUnknowns;
-    stats.kineticEnergy += report.kineticEnergy;
-    stats.maxStrain = std::max(stats.maxStrain, report.maxStrain);
-    stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
-  }
-  std::size_t k = 0;
+  // The colliders at the frame start; the pipeline poses its own copies per substep, and they
+  // end the frame advanced by their velocities.
+  m_colliderSources.clear();
   for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (!collider->shape) continue;
-    (void)setMotion(*collider->shape, advanceMotion(m_colliderStartMotions[k++], frameDt));
+    if (collider->shape) m_colliderSources.push_back({&*collider->shape, collider->settings.friction});
   }
-  collideCloths(frameDt, stats);
+  m_steppedCloths.clear();
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (slot->cloth) m_steppedCloths.push_back(slot->cloth.get());
+  }
+  m_pipeline->stepFrame(m_steppedCloths, m_colliderSources, m_time, frameDt, plan, stats);
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (collider->shape) {
+      (void)setMotion(*collider->shape, advanceMotion(motion(*collider->shape), frameDt));
+    }
+  }
+  const Index totalSubsteps = stats.substeps * (Index(m_steppedCloths.size()) - stats.sleepingCloths);
   m_time += frameDt;
   stats.simulatedTime = m_time;
   stats.stepMs =
@@ -488,42 +453,6 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
                       plan.cgTolerance > 0 ? plan.cgTolerance : defaultTolerance, costSmoothing);
   m_stats = stats;
   return stats.status;
-}
-
-void World::gatherColliderFrames(bool untilNow) {
-  m_colliderFrames.clear();
-  std::size_t k = 0;
-  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (!collider->shape) continue;
-    ColliderFrame frame;
-    frame.shape = &*collider->shape;
-    frame.start = m_colliderStartMotions[k++];
-    frame.end = untilNow ? motion(*collider->shape) : frame.start;
-    frame.friction = collider->settings.friction;
-    m_colliderFrames.push_back(frame);
-  }
-}
-
-void World::collideCloths(Real frameDt, StepStats& stats) {
-  m_clothContact->beginFrame();
-  for (std::size_t k = 0; k < m_slots.size(); ++k) {
-    const ClothSlot& slot = *m_slots[k];
-    if (!slot.cloth || !slot.cloth->settings().collideWithOtherCloths) continue;
-    m_clothContact->addCloth(ClothId{std::uint32_t(k + 1), slot.generation}, slot.cloth.get());
-  }
-  // The colliders over the whole frame: from their start motions to where they are now.
-  gatherColliderFrames(/*untilNow=*/true);
-  const SelfCollisionReport report = m_clothContact->resolveFrame(frameDt, m_colliderFrames);
-  if (report.proximityContacts + report.impacts + report.impactZones > 0) {
-    // The pass moved vertices after the cloths measured their strain: the frame ends here.
-    stats.maxStrain = 0;
-    for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-      if (slot->cloth) stats.maxStrain = std::max(stats.maxStrain, slot->cloth->maxStrain());
-    }
-  }
-  stats.clothContacts += report.proximityContacts;
-  stats.clothImpacts += report.impacts;
-  stats.clothImpactZones += report.impactZones;
 }
 
 Result<ClothRenderView> World::renderView(ClothId id) const {

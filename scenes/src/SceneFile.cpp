@@ -76,6 +76,13 @@ class Reader {
   bool full() const { return m_issues.size() >= m_options.maxIssues; }
   std::size_t issueCount() const { return m_issues.size(); }
 
+  // Reports `key` of `object`, a key the format no longer has, with what replaced it.
+  void removedKey(const Json& object, const std::string& path, const char* key, const char* why) {
+    if (object.is_object() && object.contains(key)) {
+      fail(child(path, key), std::string("\"") + key + "\" no longer exists: " + why);
+    }
+  }
+
   // Reports keys of `object` that are not in `allowed`.
   void checkKeys(const Json& object, const std::string& path,
                  std::initializer_list<std::string_view> allowed) {
@@ -361,11 +368,14 @@ void readSprings(Reader& reader, const Json& object, const std::string& path, Ma
 
 void readSolver(Reader& reader, const Json& object, const std::string& path, SolverSettings& s) {
   if (!reader.expectObject(object, path, "solver settings")) return;
+  reader.removedKey(object, path, "selfContactStiffness",
+                    "self-contacts are constraints of the contact projection in every substep; "
+                    "delete the key");
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
                     "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "tightCgTolerance",
                     "tightSelfContactDensity", "tightPinTravel", "cgTolerance", "cgStopping",
-                    "cgMaxIterations", "warmStart", "selfContactStiffness"});
+                    "cgMaxIterations", "warmStart"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
     const std::optional<IntegratorKind> kind = integratorFromName(name);
@@ -389,8 +399,6 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
                   "cloth sizes");
   reader.readReal(object, path, "pinTeleportAngle", s.pinTeleportAngle, Range::NonNegative, "rad");
-  reader.readReal(object, path, "selfContactStiffness", s.selfContactStiffness, Range::NonNegative,
-                  "multiples of the stretch stiffness");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
   reader.readReal(object, path, "tightCgTolerance", s.tightCgTolerance, Range::NonNegative,
                   "relative residual, 0 = off");
@@ -527,10 +535,12 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
                                           const std::string& path, std::size_t index,
                                           std::vector<PendingAttachment>& attachments) {
   if (!reader.expectObject(object, path, "a cloth")) return std::nullopt;
+  reader.removedKey(object, path, "jointContactProjection",
+                    "collider contacts, self-contacts and the strain limit are projected together "
+                    "in every substep; delete the key");
   reader.checkKeys(object, path,
                    {"name", "grid", "mesh", "translation", "rotation", "forceModel", "material",
-                    "springs", "solver", "selfCollision", "faceContacts", "jointContactProjection",
-                    "initialPleats", "pins"});
+                    "springs", "solver", "selfCollision", "faceContacts", "initialPleats", "pins"});
   ClothDescription cloth;
   cloth.name = "cloth " + std::to_string(index);
   reader.readString(object, path, "name", cloth.name);
@@ -587,7 +597,6 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
   if (const Json* solver = Reader::member(object, "solver")) readSolver(reader, *solver, child(path, "solver"), settings.solver);
   reader.readBool(object, path, "selfCollision", settings.selfCollision);
   reader.readBool(object, path, "faceContacts", settings.faceContacts);
-  reader.readBool(object, path, "jointContactProjection", settings.jointContactProjection);
 
   if (const Json* pleats = Reader::member(object, "initialPleats")) {
     const std::string here = child(path, "initialPleats");

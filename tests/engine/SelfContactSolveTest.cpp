@@ -1,7 +1,6 @@
-// Self-contacts inside the implicit solve (SolverSettings::selfContactStiffness): the corner
-// crumple of CollisionScenesTest, whose pile keeps stirring when the solve ignores the contacts
-// the self-collision pass then restores (tests/README.md, "why a crumpled pile can stir
-// forever"), settles with them, and stays bitwise identical on one and two threads.
+// Crumpled piles and folds held by self-contact: the corner crumple of CollisionScenesTest settles
+// at a tight solver tolerance, a napkin folded by its pins stays untangled whatever the solve's
+// form, and the pile is bitwise identical on one and two threads.
 #include "ContactTestSupport.h"
 
 #include <weft/collision/Plane.h>
@@ -36,7 +35,6 @@ TEST(SelfContactSolve, ACrumpledPileSettlesAtATightSolverTolerance) {
     const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
     ClothSettings settings = cornerDrop(*model, lift);
     settings.solver.cgTolerance = 1e-4;
-    settings.solver.selfContactStiffness = 1;
     const ClothId cloth = world.createCloth(model, settings).value();
     IntersectionCounter counter(world, {cloth});
     Index selfContacts = 0;
@@ -75,7 +73,6 @@ TEST(SelfContactSolve, ANapkinFoldedByItsPinsStaysUntangledWithPinsRemovedKeptOr
     const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
     ClothSettings settings;
     for (Index c = 0; c < kSide; ++c) settings.pinnedVertices.push_back(c);
-    settings.solver.selfContactStiffness = 1;
     settings.solver.removePinnedVertices = variant.removePins;
     settings.solver.newtonIterations = variant.newtonIterations;
     const ClothId cloth = world.createCloth(horizontalSquare(kSide, kSize, 0.01), settings).value();
@@ -129,7 +126,6 @@ TEST(SelfContactSolve, ThePileIsBitwiseIdenticalOnOneAndTwoThreads) {
     World world(worldSettings);
     (void)world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
     ClothSettings settings = cornerDrop(*model, 0.3);
-    settings.solver.selfContactStiffness = 1;
     (void)world.createCloth(model, settings).value();
     Index selfContacts = 0;
     for (int frame = 0; frame < 120; ++frame) {

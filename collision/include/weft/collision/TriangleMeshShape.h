@@ -26,6 +26,7 @@
 #include <weft/collision/RigidMotion.h>
 #include <weft/collision/ShapeContact.h>
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -43,13 +44,13 @@ class TriangleMeshShape {
                                           const RigidMotion& motion = {});
 
   /// m, vertices in the body frame.
-  const std::vector<Vec3>& localVertices() const { return m_localVertices; }
+  const std::vector<Vec3>& localVertices() const { return m_geometry->vertices; }
   /// Three vertex indices per triangle.
-  const std::vector<Index>& indices() const { return m_indices; }
+  const std::vector<Index>& indices() const { return m_geometry->indices; }
   /// Number of triangles.
-  Index triangleCount() const { return static_cast<Index>(m_indices.size() / 3); }
+  Index triangleCount() const { return static_cast<Index>(m_geometry->indices.size() / 3); }
   /// The tree over the body-frame triangles (zero thickness).
-  const Bvh& localBvh() const { return m_localBvh; }
+  const Bvh& localBvh() const { return m_geometry->bvh; }
   /// Writes the vertices at the current pose into `vertices` (size localVertices().size()).
   void worldVertices(std::span<Vec3> vertices) const;
 
@@ -64,12 +65,18 @@ class TriangleMeshShape {
   Aabb bounds() const;
 
  private:
-  std::vector<Vec3> m_localVertices;
-  std::vector<Index> m_indices;
-  Bvh m_localBvh;
-  std::vector<Vec3> m_faceNormals;    // per triangle, unit
-  std::vector<Vec3> m_edgeNormals;    // per triangle corner k: edge (k, k+1), unit
-  std::vector<Vec3> m_vertexNormals;  // per vertex, angle-weighted, unit
+  TriangleMeshShape() = default;  // create() builds every shape: none exists without geometry
+  // The body-frame geometry, immutable once built and shared by every copy of the shape: a copy
+  // (a collider posed for one substep, a saved world) costs a reference count, not the mesh.
+  struct Geometry {
+    std::vector<Vec3> vertices;
+    std::vector<Index> indices;
+    Bvh bvh;
+    std::vector<Vec3> faceNormals;    // per triangle, unit
+    std::vector<Vec3> edgeNormals;    // per triangle corner k: edge (k, k+1), unit
+    std::vector<Vec3> vertexNormals;  // per vertex, angle-weighted, unit
+  };
+  std::shared_ptr<const Geometry> m_geometry;
   RigidMotion m_motion;
 };
 

@@ -174,34 +174,6 @@ struct SolverSettings {
   /// right-hand side) instead of keeping them in it filtered (S = 0). Same equations, so the same
   /// motion up to the solve tolerance; the solve shrinks by one row per pin. false is for checks.
   bool removePinnedVertices = true;
-  /// Self-contacts inside the implicit solve, as a multiple of the cloth's stretch stiffness
-  /// (dimensionless; 0 = off, must be finite and ≥ 0). Each pair of the cloth within two
-  /// thicknesses at the step start (vertex–triangle or edge–edge, found as the self-collision
-  /// pass finds its proximity pairs, after a substep that had self-contacts) becomes a one-sided
-  /// penalty ½ k (d₀ − d)² on its gap d along its normal, d₀ = material.thickness, with
-  /// k = selfContactStiffness × the stretch stiffness (N/m: the larger of material.warp/
-  /// weftStretchStiffness, or springs.structuralStiffness for mass–spring cloth): 1 gives a
-  /// contact the h²k/m of an edge (~300 on cotton at 1/60 s), so the solve can no longer relax
-  /// strain by moving a layer through another. Treated implicitly, coupling all four vertices
-  /// (engine/src/solver/ContactCoupling.h); a pair acts only while its force at the end of the
-  /// step pushes (an active set, up to two re-solves). Without it the solve moves layers through
-  /// each other towards the unconstrained equilibrium and the self-collision pass after it pushes
-  /// them back, which can keep a jammed pile stirring (tests/README.md). The self-collision pass
-  /// still runs after the solve and keeps the last word. Implicit integrator with selfCollision
-  /// only; ignored otherwise. Raising it makes contacts harder in the solve and its CG slower.
-  /// Measured at 1 (Release, shared machine): the corner crumple (5 tolerances × 3 drop heights,
-  /// 400 frames) settled in 10 of 15 runs against 3 of 15 (median end energy 3.3e-7 J against
-  /// 6.1e-4 J; 0.1, 0.3 and 3 settled 9, 9 and 9: no clear optimum), at cgTolerance 1e-4 in 9 of
-  /// 9 drop heights against 2; stress scene 10 dragged (weft-teleport-perturb
-  /// --pin-teleport-distance 0) 0 of 24 runs fail against 6, 0 of 48 with --sleep-variants as
-  /// before. (These figures are with every solve at the relative residual 1e-3, the default
-  /// before the contact-aware accuracy; with today's default, loose between hard substeps, the
-  /// dragged pins fail 4 of 24 with it on and 6 of 24 off: `--former-default-solve` gives 0.) Why it is off: the curtain's CG iterations per frame go from 20.6 to 52.9 (max 305)
-  /// and its p95 frame time doubles (the Gauss–Seidel preconditioner holds a contact's diagonal
-  /// blocks but not its couplings), and stress scene 7 ends at strain 0.36 instead of 0.27 (0.33,
-  /// 0.44, 0.31 at 0.3, 3, 10): its stretch comes from the self-collision pass against the
-  /// colliders, which this does not change.
-  Real selfContactStiffness = 0;
 };
 
 }  // namespace weft

@@ -28,9 +28,10 @@
 
 namespace weft {
 
-struct ColliderFrame;  // internal: a collider as one step sees it
+struct ColliderSource;  // internal: a collider as a frame sees it
+class Cloth;           // internal: one cloth's state, forces and integrator
 class FrameCostModel;  // internal: the budget planner
-class ClothClothCollision;  // internal: contact between cloths
+class SubstepPipeline;  // internal: the frame's substeps
 
 /// Handle to a cloth in a World. Zero-initialised = null.
 struct ClothId {
@@ -92,20 +93,10 @@ struct ClothSettings {
   /// Costs a box test per triangle per nearby collider per collision pass (and a tree query for
   /// a mesh), and closest-point tests near the body; turn off only for meshes much finer than every collider.
   bool faceContacts = true;
-  /// With the strain limiter on: in a substep in which the cloth touches a collider and itself,
-  /// the limiter's rounds in contact satisfy the edge limits, every self-contact of the substep and
-  /// the vertices' and faces' collider contacts together (ColliderProjection) instead of one pass
-  /// after the other. Keeps cloth jammed between bodies within the strain limit (three sheets
-  /// pushed through a ring of capsules: 0.101 instead of 0.79 … 4.7); costs up to 4 times the
-  /// limiter's iterations and rounds in such substeps (the curtain: p50 about 2 %).
-  /// Off, and in substeps without self-contacts: the sequential rounds, collider contacts held
-  /// along their normals (which keep a cloth resting on a body still; the projection takes no
-  /// friction).
-  bool jointContactProjection = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
   /// Keeps the cloth from passing through other cloths of the world that have this switch on
-  /// too (contact resolved once per frame, after every cloth has stepped). Costs a bounds test
-  /// per frame while the cloths are apart.
+  /// too (resolved in every substep with the cloth's own contacts). Costs a bounds test per
+  /// substep while the cloths are apart.
   bool collideWithOtherCloths = true;
 };
 
@@ -270,18 +261,15 @@ class World {
   const ColliderSlot* find(ColliderId collider) const;
   ColliderSlot* find(ColliderId collider);
   void updateAttachedPins(Real frameDt);
-  // Fills m_colliderFrames from m_colliderStartMotions: each collider from its frame-start
-  // motion to the same (a cloth poses them per substep itself) or, untilNow, to where it is now.
-  void gatherColliderFrames(bool untilNow);
 
   WorldSettings m_settings;
   std::unique_ptr<TaskSystem> m_ownedTasks;  // when the caller gave none
   TaskSystem* m_tasks = nullptr;
   std::vector<std::unique_ptr<ClothSlot>> m_slots;
   std::vector<std::unique_ptr<ColliderSlot>> m_colliderSlots;
-  std::vector<ColliderFrame> m_colliderFrames;  // scratch for step()
-  std::vector<RigidMotion> m_colliderStartMotions;  // scratch for step()
-  std::vector<Vec3> m_attachedTargets;              // scratch for step()
+  std::vector<ColliderSource> m_colliderSources;  // scratch for step()
+  std::vector<Cloth*> m_steppedCloths;            // scratch for step()
+  std::vector<Vec3> m_attachedTargets;            // scratch for step()
   // Runs one frame with `plan`; budgetMs > 0 reports a miss; the cost model is refitted from the
   // frame's timings (weight costSmoothing) assuming `defaultTolerance` where the plan has none.
   StepStatus stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs, Real costSmoothing,
@@ -290,9 +278,7 @@ class World {
   StepStats m_stats;
   Real m_time = 0;
 
-  // Contact between cloths, after every cloth has stepped the frame (ClothClothCollision.h).
-  void collideCloths(Real frameDt, StepStats& stats);
-  std::unique_ptr<ClothClothCollision> m_clothContact;
+  std::unique_ptr<SubstepPipeline> m_pipeline;  // every frame's substeps
   std::uint64_t m_identity = 0;  // unique per World, so a state saved elsewhere is refused
 };
 

@@ -1,0 +1,113 @@
+// ContactDetector: finds the contacts of one substep, for every cloth of the contact space at once.
+//
+// Two passes. Before the implicit solve, the predicted motion x₀ + h v₀ of every vertex is traced
+// against the colliders (relative to each body, from the start point carried with it): a vertex
+// predicted to end within the contact shell is constrained in the solve along the contact normal
+// so that the step ends at the thickness (Baraff & Witkin 1998, §5.3), and the corners of faces
+// resting on a body by their interior (a towel on a rod) likewise. After the solve, the solved
+// motion x₀ → x₁ gives the ContactSet the projector enforces:
+//  - vertex–collider: vertices whose path or end comes within the thickness plus a margin of a
+//    collider (the projector evaluates each at its current position, so the margin lets it follow
+//    a vertex the projection moves towards the body);
+//  - face–collider: faces whose path reaches a core of a body thinner than the triangles
+//    (FaceCores.h);
+//  - vertex–face and edge–edge pairs, within a cloth and between cloths: one broad phase over
+//    the swept boxes (FeaturePairs), the closest points at both ends, a pair closer than its
+//    thickness at either end being a contact (Bridson, Fedkiw & Anderson 2002, §7.2). The weights
+//    and normal are those of the nearer end, oriented to the side the pair started on, which x₀
+//    (free of crossings) tells. Features closer than the thickness in the rest shape of one cloth
+//    are neighbours in the material and never a contact.
+// The exact tests run in parallel over fixed blocks; contacts are put back in pair order, so the
+// set is the same on any thread count.
+#pragma once
+
+#include "contact/ColliderFrame.h"
+#include "contact/ContactSet.h"
+#include "contact/ContactSpace.h"
+#include "contact/FeaturePairs.h"
+
+#include <weft/threading/PerWorker.h>
+#include <weft/threading/TaskSystem.h>
+
+#include <memory>
+#include <span>
+#include <vector>
+
+namespace weft {
+
+/// A constraint of the implicit solve: the velocity change of `vertex` along `normal` is fixed
+/// to `normalChange` (m/s), so that its predicted motion ends at the contact distance.
+struct SolveConstraint {
+  Index vertex = 0;  ///< of the contact space
+  Vec3 normal = Vec3::Zero();
+  Real normalChange = 0;
+  Index collider = kInvalidIndex;  ///< the collider, or kInvalidIndex for a face's corner
+};
+
+/// A face point resting on a core at the end of a substep, whose corners the next solve holds.
+struct FaceSupport {
+  std::array<Index, 3> corners{};
+  Vec3 barycentric = Vec3::Zero();
+  Vec3 normal = Vec3::Zero();  ///< world, from the core to the face
+  Real level = 0;              ///< m: the face point must keep normal · point ≥ level
+};
+
+/// What detection found, for the step's statistics.
+struct DetectionCounts {
+  Index colliderPairsTested = 0;   ///< vertex sets tested against a collider's box hit
+  Index colliderPairsSkipped = 0;  ///< colliders whose box missed the cloth's
+};
+
+class ContactDetector {
+ public:
+  /// Builds the broad-phase tables of `space` (when its cloths change).
+  void build(const ContactSpace& space, TaskSystem* tasks);
+  /// Leaves of the broad phase keep their boxes while their triangles move less than this (m).
+  void setRefitMargin(Real margin) { m_features.setRefitMargin(margin); }
+  /// The solve's constraints for the predicted motion x₀ + h v₀ (space.startX, startV) against
+  /// `colliders`, and for the corners of `supports` (faces resting on a body), into `out`
+  /// (cleared first), by vertex.
+  void constrain(const ContactSpace& space, std::span<const ColliderFrame> colliders, Real h,
+                 std::span<const FaceSupport> supports, std::vector<SolveConstraint>& out,
+                 DetectionCounts& counts);
+  /// The contacts of the solved motion space.startX → space.x into `set` (cleared first).
+  /// `solveImpulses` (m/s per vertex) and `constrainedCollider` (per vertex, kInvalidIndex:
+  /// none) say what the solve's constraints did. `pairs`: detect cloth pairs (false when no
+  /// cloth can touch itself or another this substep). `margin` (m): how far beyond its thickness
+  /// a vertex may be from a collider and still be a contact.
+  void detect(const ContactSpace& space, std::span<const ColliderFrame> colliders,
+              std::span<const Real> solveImpulses, std::span<const Index> constrainedCollider,
+              bool pairs, Real margin, ContactSet& set, DetectionCounts& counts);
+
+  /// Broad-phase nodes refit and kept since the last call.
+  Bvh::RefitCounts takeRefitCounts() { return m_features.takeRefitCounts(); }
+
+ private:
+  void detectColliderVertices(const ContactSpace& space, std::span<const ColliderFrame> colliders,
+                              std::span<const Real> solveImpulses,
+                              std::span<const Index> constrainedCollider, Real margin,
+                              ContactSet& set);
+  void detectColliderFaces(const ContactSpace& space, std::span<const ColliderFrame> colliders,
+                           ContactSet& set);
+  void detectPairs(const ContactSpace& space, ContactSet& set);
+  // The colliders whose box comes near the cloth's motion, into m_near; counts both kinds.
+  void selectNear(const ContactSpace& space, std::span<const ColliderFrame> colliders,
+                  const Vec3Array& end, Real margin, DetectionCounts& counts);
+
+  TaskSystem* m_tasks = nullptr;
+  FeaturePairs m_features;
+  std::vector<Index> m_near;  // colliders near the cloth this pass
+  struct FoundContact {
+    Index pair;
+    Contact contact;
+  };
+  std::unique_ptr<PerWorker<std::vector<FoundContact>>> m_workerContacts;
+  std::vector<FoundContact> m_found;
+  std::vector<Index> m_meshTriangles;
+  std::vector<std::pair<Index, Index>> m_meshEdges;
+  std::vector<FaceCore> m_bodyCores;
+  Vec3Array m_predicted;            // x₀ + h v₀, constrain()
+  std::vector<char> m_constrained;  // per vertex: constrained by constrain() already
+};
+
+}  // namespace weft

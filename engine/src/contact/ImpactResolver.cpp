@@ -1,0 +1,395 @@
+#include "contact/ImpactResolver.h"
+
+#include <weft/collision/ContinuousCollision.h>
+#include <weft/threading/Profiler.h>
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+namespace weft {
+namespace {
+
+// Passes of impulse-based continuous detection before the impact zones take over.
+constexpr int kImpulsePasses = 6;
+// Merging passes of the impact zones before the last resort freezes what still collides.
+constexpr int kZonePasses = 12;
+// A swept hit is resolved to a separating speed that opens this share of the thickness within
+// the substep, so the pair is not found touching again at its end.
+constexpr Real kImpactSeparation = 0.25;
+// Feature pairs per parallel block: a swept test costs a few hundred ns, so 128 pairs are tens
+// of µs of work.
+constexpr TaskSystem::Index kGrainFeaturePairs = 128;
+// A vertex that ends within this many thicknesses of a collider is held by it in the impulses.
+constexpr Real kHeldReach = 1.5;
+// A held vertex counts as 1000× heavier in impulses, so the free side of a pair takes them.
+constexpr Real kHeldInverseMassScale = 1e-3;
+
+Index findRoot(std::vector<Index>& parent, Index vertex) {
+  while (parent[vertex] != vertex) {
+    parent[vertex] = parent[parent[vertex]];  // path halving
+    vertex = parent[vertex];
+  }
+  return vertex;
+}
+
+}  // namespace
+
+void ImpactResolver::build(const ContactSpace& space, TaskSystem* tasks) {
+  m_tasks = tasks;
+  m_features.build(space, tasks);
+  if (m_tasks && !m_tasks->isSerial() && !m_workerImpacts) {
+    m_workerImpacts = std::make_unique<PerWorker<std::vector<FoundImpact>>>(*m_tasks);
+  }
+  const Index n = space.vertexCount();
+  m_zoneParent.resize(n);
+  m_velocity.resize(n);
+  m_end.resize(n);
+  m_testedEnd.resize(n);
+}
+
+Index ImpactResolver::keepOutOfColliders(ContactSpace& space,
+                                         std::span<const ColliderFrame> colliders, Real h) {
+  m_near.clear();
+  if (colliders.empty()) return 0;
+  Real thickness = 0;
+  for (const ContactOwner& owner : space.owners) thickness = std::max(thickness, owner.thickness);
+  Aabb path = Aabb::empty();
+  for (Index i = 0; i < space.vertexCount(); ++i) {
+    if (space.inverseMass[i] == 0) continue;
+    path.expand(space.startX[i]);
+    path.expand(space.x[i]);
+  }
+  for (Index k = 0; k < Index(colliders.size()); ++k) {
+    Aabb box = path;
+    if (!colliders[k].still()) {
+      for (Index i = 0; i < space.vertexCount(); ++i) {
+        if (space.inverseMass[i] != 0) box.expand(colliders[k].carry(space.startX[i]));
+      }
+    }
+    if (mayTouch(colliders[k].shape, box, thickness * (1 + 1e-6) + 1e-9)) m_near.push_back(k);
+  }
+  if (m_near.empty()) return 0;
+  WEFT_PROFILE_ZONE("collider impacts");
+  Index corrected = 0;
+  for (Index i = 0; i < space.vertexCount(); ++i) {
+    if (space.inverseMass[i] == 0) continue;
+    const Real thickness = space.owners[space.owner[i]].thickness;
+    bool moved = false;
+    for (Index k : m_near) {
+      const ColliderFrame& collider = colliders[k];
+      const Vec3 outside = keepOutside(collider, space.startX[i], space.x[i], thickness);
+      if (outside == space.x[i]) continue;
+      space.v[i] += (outside - space.x[i]) / h;
+      space.x[i] = outside;
+      // Inelastic: no relative velocity into the surface.
+      const ShapeContact on = queryPoint(collider.shape, outside);
+      const Real approach = (space.v[i] - on.velocity).dot(on.normal);
+      if (approach < 0) space.v[i] -= approach * on.normal;
+      moved = true;
+    }
+    corrected += moved;
+  }
+  return corrected;
+}
+
+Real ImpactResolver::impulseInverseMass(Index vertex, const ContactSpace& space) {
+  const Real inverseMass = space.inverseMass[vertex];
+  if (m_near.empty() || inverseMass == 0) return inverseMass;
+  // Decided on first use, from where the substep was to end: impulses run serially, so the
+  // cache fills in the same order on any thread count.
+  if (m_held[vertex] < 0) {
+    const Real reach = kHeldReach * space.owners[space.owner[vertex]].thickness;
+    m_held[vertex] = 0;
+    for (Index k : m_near) {
+      if (queryPoint(m_colliders[k].shape, space.x[vertex]).distance < reach) m_held[vertex] = 1;
+    }
+  }
+  return m_held[vertex] ? kHeldInverseMassScale * inverseMass : inverseMass;
+}
+
+void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
+  if (m_near.empty()) return;
+  for (Index i = 0; i < space.vertexCount(); ++i) {
+    if (!m_touched[i]) continue;
+    const Real thickness = space.owners[space.owner[i]].thickness;
+    for (Index k : m_near) {
+      // The way there, relative to the body, not only the end: an impulse may send a vertex
+      // through a thin or fast body.
+      const Vec3 end = space.startX[i] + h * m_velocity[i];
+      const Vec3 outside = keepOutside(m_colliders[k], space.startX[i], end, thickness);
+      if (outside != end) m_velocity[i] = (outside - space.startX[i]) / h;
+    }
+  }
+}
+
+void ImpactResolver::applyImpulse(const Impact& impact, Real targetNormalSpeed,
+                                  const ContactSpace& space) {
+  Vec3 relative = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) relative += impact.weights[k] * m_velocity[impact.vertices[k]];
+  const Real normalSpeed = relative.dot(impact.normal);
+  if (normalSpeed >= targetNormalSpeed) return;
+  Real effective = 0;
+  std::array<Real, 4> inverseMass;
+  for (int k = 0; k < 4; ++k) {
+    inverseMass[k] = impulseInverseMass(impact.vertices[k], space);
+    effective += impact.weights[k] * impact.weights[k] * inverseMass[k];
+  }
+  if (effective <= 0) return;  // all four pinned
+  // When the free side holds the pair point only with a small weight, taking all of the
+  // relative change would throw that vertex at Δu / w: the true masses share it instead, and the
+  // clamp afterwards puts back what reaches into a collider.
+  Real largestShare = 0;
+  for (int k = 0; k < 4; ++k) {
+    largestShare = std::max(largestShare, std::abs(impact.weights[k]) * inverseMass[k]);
+  }
+  if (largestShare > effective) {
+    effective = 0;
+    for (int k = 0; k < 4; ++k) {
+      inverseMass[k] = space.inverseMass[impact.vertices[k]];
+      effective += impact.weights[k] * impact.weights[k] * inverseMass[k];
+    }
+  }
+  const Real normalChange = targetNormalSpeed - normalSpeed;
+  Vec3 change = normalChange * impact.normal;
+  // Coulomb friction: at most μ·|Δu_n| of relative tangential speed.
+  const Vec3 tangential = relative - normalSpeed * impact.normal;
+  const Real tangentialSpeed = tangential.norm();
+  if (impact.friction > 0 && tangentialSpeed > 0) {
+    change -= std::min<Real>(1, impact.friction * normalChange / tangentialSpeed) * tangential;
+  }
+  // Δv_i = w_i λ / m_i with λ = Δu / Σ w_j² / m_j gives exactly the relative change Δu.
+  const Vec3 lambda = change / effective;
+  for (int k = 0; k < 4; ++k) {
+    const Index vertex = impact.vertices[k];
+    m_velocity[vertex] += impact.weights[k] * inverseMass[k] * lambda;
+    m_touched[vertex] = 1;
+  }
+}
+
+bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
+  const Vec3Array& start = space.startX;
+  const Index n = space.vertexCount();
+  for (Index i = 0; i < n; ++i) m_end[i] = start[i] + h * m_velocity[i];
+  // The swept test's tolerance is 1 µm: boxes inflated by a little more catch all it reports.
+  const Real inflate = 2 * kDefaultContactTolerance;
+  // Only pairs with a vertex whose end moved since the last test, or that was in one of its
+  // hits, can test differently: the others would test exactly as then, negative.
+  bool any = false;
+  for (Index i = 0; i < n; ++i) {
+    if (m_dirty[i] || std::memcmp(&m_end[i], &m_testedEnd[i], sizeof(Vec3)) != 0) {
+      m_dirty[i] = 1;
+      any = true;
+    }
+  }
+  m_impacts.clear();
+  if (!any) return false;
+  m_features.find(space, start, m_end, inflate, &m_dirty);
+  const auto& vertexTriangle = m_features.vertexTriangle();
+  const auto& edgeEdge = m_features.edgeEdge();
+  const Index vertexTriangleCount = Index(vertexTriangle.size());
+  const Index total = vertexTriangleCount + Index(edgeEdge.size());
+  auto test = [&](Index pair, Impact& impact) -> bool {
+    if (pair < vertexTriangleCount) {
+      const auto& [vertex, triangle] = vertexTriangle[pair];
+      const std::array<Index, 3>& c = space.triangles[triangle];
+      const std::array<Vec3, 3> triangleStart{start[c[0]], start[c[1]], start[c[2]]};
+      const std::array<Vec3, 3> triangleEnd{m_end[c[0]], m_end[c[1]], m_end[c[2]]};
+      const std::optional<VertexTriangleImpact> hit =
+          sweptVertexTriangle(start[vertex], m_end[vertex], triangleStart, triangleEnd);
+      if (!hit) return false;
+      const Real t = hit->time;
+      auto at = [&](Index i) { return Vec3(start[i] + t * (m_end[i] - start[i])); };
+      Vec3 normal = (at(c[1]) - at(c[0])).cross(at(c[2]) - at(c[0]));
+      if (normal.norm() == 0) return false;  // degenerate at impact: the zones catch it
+      normal.normalize();
+      const Vec3 startPoint = hit->barycentric[0] * triangleStart[0] +
+                              hit->barycentric[1] * triangleStart[1] +
+                              hit->barycentric[2] * triangleStart[2];
+      if (normal.dot(start[vertex] - startPoint) < 0) normal = -normal;
+      impact = {{vertex, c[0], c[1], c[2]},
+                {1, -hit->barycentric[0], -hit->barycentric[1], -hit->barycentric[2]},
+                normal, space.pairThickness(vertex, c[0]), space.pairFriction(vertex, c[0])};
+      return true;
+    }
+    const auto& [firstEdge, secondEdge] = edgeEdge[pair - vertexTriangleCount];
+    const std::array<Index, 2>& p = space.edges[firstEdge];
+    const std::array<Index, 2>& q = space.edges[secondEdge];
+    const std::optional<EdgeEdgeImpact> hit =
+        sweptEdgeEdge({start[p[0]], start[p[1]]}, {m_end[p[0]], m_end[p[1]]},
+                      {start[q[0]], start[q[1]]}, {m_end[q[0]], m_end[q[1]]});
+    if (!hit) return false;
+    const Real t = hit->time, s = hit->firstParameter, u = hit->secondParameter;
+    auto at = [&](Index i) { return Vec3(start[i] + t * (m_end[i] - start[i])); };
+    Vec3 normal = (at(p[1]) - at(p[0])).cross(at(q[1]) - at(q[0]));
+    const Vec3 startGap =
+        ((1 - s) * start[p[0]] + s * start[p[1]]) - ((1 - u) * start[q[0]] + u * start[q[1]]);
+    if (normal.norm() < 1e-12) normal = startGap;  // parallel edges: the gap is the direction
+    if (normal.norm() == 0) return false;
+    normal.normalize();
+    if (normal.dot(startGap) < 0) normal = -normal;
+    impact = {{p[0], p[1], q[0], q[1]}, {1 - s, s, -(1 - u), -u}, normal,
+              space.pairThickness(p[0], q[0]), space.pairFriction(p[0], q[0])};
+    return true;
+  };
+  WEFT_PROFILE_ZONE("swept tests");
+  if (!m_workerImpacts || total <= kGrainFeaturePairs) {
+    Impact impact;
+    for (Index pair = 0; pair < total; ++pair) {
+      if (test(pair, impact)) m_impacts.push_back(impact);
+    }
+  } else {
+    m_workerImpacts->forEach([](std::vector<FoundImpact>& found) { found.clear(); });
+    m_tasks->parallelFor(total, kGrainFeaturePairs, [&](Index begin, Index end, int worker) {
+      std::vector<FoundImpact>& found = (*m_workerImpacts)[worker];
+      Impact impact;
+      for (Index pair = begin; pair < end; ++pair) {
+        if (test(pair, impact)) found.push_back({pair, impact});
+      }
+    });
+    m_found.clear();
+    m_workerImpacts->forEach([this](std::vector<FoundImpact>& found) {
+      m_found.insert(m_found.end(), found.begin(), found.end());
+    });
+    std::sort(m_found.begin(), m_found.end(),
+              [](const FoundImpact& a, const FoundImpact& b) { return a.pair < b.pair; });
+    for (const FoundImpact& found : m_found) m_impacts.push_back(found.impact);
+    const std::size_t count = m_found.size();
+    m_workerImpacts->forEach([count](std::vector<FoundImpact>& found) {
+      if (found.capacity() < count) found.reserve(count);
+    });
+  }
+  // The next test needs only the vertices whose ends move from here, and those of the hits.
+  m_testedEnd = m_end;
+  std::fill(m_dirty.begin(), m_dirty.end(), char(0));
+  for (const Impact& impact : m_impacts) {
+    for (Index vertex : impact.vertices) m_dirty[vertex] = 1;
+  }
+  return !m_impacts.empty();
+}
+
+void ImpactResolver::rigidifyZones(const ContactSpace& space) {
+  // Each zone's vertices (ordered by root, then vertex: deterministic) get one rigid velocity
+  // that keeps the zone's linear and angular momentum. Pinned vertices, of infinite mass, make
+  // the zone move with them instead.
+  const Vec3Array& start = space.startX;
+  m_zoneOrder.clear();
+  for (Index vertex = 0; vertex < space.vertexCount(); ++vertex) {
+    if (m_inZone[vertex]) m_zoneOrder.push_back(vertex);
+  }
+  std::stable_sort(m_zoneOrder.begin(), m_zoneOrder.end(), [&](Index a, Index b) {
+    return findRoot(m_zoneParent, a) < findRoot(m_zoneParent, b);
+  });
+  for (std::size_t begin = 0; begin < m_zoneOrder.size();) {
+    const Index root = findRoot(m_zoneParent, m_zoneOrder[begin]);
+    std::size_t end = begin;
+    while (end < m_zoneOrder.size() && findRoot(m_zoneParent, m_zoneOrder[end]) == root) ++end;
+    const std::span<const Index> members(m_zoneOrder.data() + begin, end - begin);
+    begin = end;
+    Real mass = 0;
+    Vec3 centre = Vec3::Zero(), momentum = Vec3::Zero(), pinnedVelocity = Vec3::Zero();
+    int pinned = 0;
+    for (Index vertex : members) {
+      if (space.inverseMass[vertex] == 0) {
+        pinnedVelocity += m_velocity[vertex];
+        ++pinned;
+        continue;
+      }
+      const Real m = 1 / space.inverseMass[vertex];
+      mass += m;
+      centre += m * start[vertex];
+      momentum += m * m_velocity[vertex];
+    }
+    for (Index vertex : members) m_touched[vertex] |= space.inverseMass[vertex] != 0;
+    if (pinned > 0) {
+      for (Index vertex : members) {
+        if (space.inverseMass[vertex] != 0) m_velocity[vertex] = pinnedVelocity / pinned;
+      }
+      continue;
+    }
+    if (mass == 0) continue;
+    centre /= mass;
+    const Vec3 linear = momentum / mass;
+    Vec3 angularMomentum = Vec3::Zero();
+    Mat3 inertia = Mat3::Zero();
+    for (Index vertex : members) {
+      const Real m = 1 / space.inverseMass[vertex];
+      const Vec3 r = start[vertex] - centre;
+      angularMomentum += m * r.cross(m_velocity[vertex] - linear);
+      inertia += m * (r.squaredNorm() * Mat3::Identity() - r * r.transpose());
+    }
+    // A collinear zone has a singular inertia tensor: the pseudo-inverse drops the spin about its
+    // line, which no contact could have set.
+    const Vec3 omega = inertia.completeOrthogonalDecomposition().solve(angularMomentum);
+    for (Index vertex : members) m_velocity[vertex] = linear + omega.cross(start[vertex] - centre);
+  }
+}
+
+ImpactReport ImpactResolver::resolve(ContactSpace& space, std::span<const ColliderFrame> colliders,
+                                     Real h, bool pairs) {
+  WEFT_PROFILE_ZONE("impacts");
+  ImpactReport report;
+  m_colliders = colliders;
+  report.colliderCorrections = keepOutOfColliders(space, colliders, h);
+  if (!pairs) return report;
+  const Index n = space.vertexCount();
+  const Vec3Array& start = space.startX;
+  for (Index i = 0; i < n; ++i) m_velocity[i] = (space.x[i] - start[i]) / h;
+  m_touched.assign(n, 0);
+  m_dirty.assign(n, 1);
+  if (!m_near.empty()) m_held.assign(n, -1);
+
+  bool colliding = false;
+  for (int pass = 0; pass < kImpulsePasses; ++pass) {
+    colliding = findImpacts(space, h);
+    if (!colliding) break;
+    for (const Impact& impact : m_impacts) {
+      applyImpulse(impact, kImpactSeparation * impact.thickness / h, space);
+      ++report.impacts;
+    }
+    clampToColliders(space, h);
+  }
+  if (colliding) {
+    WEFT_PROFILE_ZONE("impact zones");
+    for (Index vertex = 0; vertex < n; ++vertex) m_zoneParent[vertex] = vertex;
+    m_inZone.assign(n, 0);
+    for (int pass = 0; pass < kZonePasses && colliding; ++pass) {
+      for (const Impact& impact : m_impacts) {
+        for (Index vertex : impact.vertices) m_inZone[vertex] = 1;
+        const Index root = findRoot(m_zoneParent, impact.vertices[0]);
+        for (int k = 1; k < 4; ++k) m_zoneParent[findRoot(m_zoneParent, impact.vertices[k])] = root;
+      }
+      rigidifyZones(space);
+      clampToColliders(space, h);
+      ++report.impactZones;
+      colliding = findImpacts(space, h);
+    }
+    // Vertices that start free of crossings and do not move cannot cross: hold the rest.
+    while (colliding) {
+      const Index frozenBefore = report.frozenVertices;
+      for (const Impact& impact : m_impacts) {
+        for (Index vertex : impact.vertices) {
+          if (space.inverseMass[vertex] == 0 || m_velocity[vertex].isZero()) continue;
+          ++report.frozenVertices;
+          m_velocity[vertex].setZero();
+          m_touched[vertex] = 1;
+        }
+      }
+      // Nothing left to hold still: the pairs are between pinned vertices, which move as
+      // scripted; the caller's pins are beyond what the cloth can answer for.
+      if (report.frozenVertices == frozenBefore) break;
+      colliding = findImpacts(space, h);
+    }
+  }
+  // Only corrected vertices change; the velocity takes the change of the average velocity.
+  for (Index i = 0; i < n; ++i) {
+    if (!m_touched[i]) continue;
+    space.v[i] += m_velocity[i] - (space.x[i] - start[i]) / h;
+    space.x[i] = start[i] + h * m_velocity[i];
+  }
+  return report;
+}
+
+}  // namespace weft
