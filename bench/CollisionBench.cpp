@@ -169,7 +169,7 @@ void CollisionImpacts(benchmark::State& state) {
   impacts.build(gatheredSpace.space, &taskSystem);
   const Real h = CurtainScene::kFrameDt;
   gatheredSpace.reset(curtain, end);
-  ImpactReport report = impacts.resolve(gatheredSpace.space, {}, h, true);  // sizes every buffer
+  ImpactReport report = impacts.resolve(gatheredSpace.space, ContactSet{}, {}, h, true);  // sizes every buffer
   Profiler& profiler = Profiler::instance();
   profiler.clear();
   const std::uint64_t frame = 2'000'000 + 100 * std::uint64_t(state.range(0)) + state.range(1);
@@ -177,7 +177,7 @@ void CollisionImpacts(benchmark::State& state) {
   profiler.setEnabled(true);
   for (auto _ : state) {
     gatheredSpace.reset(curtain, end);
-    report = impacts.resolve(gatheredSpace.space, {}, h, true);
+    report = impacts.resolve(gatheredSpace.space, ContactSet{}, {}, h, true);
   }
   profiler.setEnabled(false);
   recordZones(state, frame);

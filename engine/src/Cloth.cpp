@@ -54,6 +54,7 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   m_frameStartPositions = m_positions;
   m_frameStartVelocities = m_velocities;
   m_solveContactImpulses.assign(n, 0);
+  m_frameStartCarried.reserve(n);  // the integrator's warm start, copied at every frame start
 
   // Pins start where their vertices are.
   const std::vector<Index>& pins = settings.pinnedVertices;

@@ -116,12 +116,12 @@ bool StagePlanner::pairsNeeded(const ContactSpace& space, std::span<const char> 
       box.expand(space.startX[i]);
       box.expand(space.x[i]);
     }
-    box.inflate(space.owners[c].thickness);
+    box.inflate(kPairReach * space.owners[c].thickness);
     m_boxes[c] = box;
     if (!stepping[c] || !m_folds[c]) continue;
     const std::span<const Vec3> start(space.startX.data() + first, count);
     const std::span<const Vec3> end(space.x.data() + first, count);
-    if (m_skip && m_folds[c]->cannotTouchItself(start, end, space.owners[c].thickness)) {
+    if (m_skip && m_folds[c]->cannotTouchItself(start, end, kPairReach * space.owners[c].thickness)) {
       ++skipped;
     } else {
       ++needed;

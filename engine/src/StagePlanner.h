@@ -16,6 +16,7 @@
 
 #include "FoldCulling.h"
 #include "contact/ColliderFrame.h"
+#include "contact/ContactDetector.h"
 #include "contact/ContactSpace.h"
 
 #include <memory>

@@ -67,6 +67,8 @@ void SubstepPipeline::rebuild(std::span<Cloth* const> cloths) {
   const Real refit = m_skipStages ? kRefitMotionPerThickness * thickness : -1;
   m_detector.setRefitMargin(refit);
   m_impacts.setRefitMargin(refit);
+  m_detector.setSkipping(m_skipStages);
+  m_impacts.setSkipping(m_skipStages);
   const Index n = m_space.vertexCount();
   m_solveImpulses.assign(n, 0);
   m_constrainedCollider.assign(n, kInvalidIndex);
@@ -293,12 +295,21 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   for (std::size_t e = 0; e < m_space.edges.size(); ++e) {
     strainAfterProject = std::max(strainAfterProject, (m_space.x[m_space.edges[e][1]] - m_space.x[m_space.edges[e][0]]).norm() / m_space.restLengths[e] - 1);
   }
-  const ImpactReport impacts = m_impacts.resolve(m_space, m_colliders, h, pairs);
+  const ImpactReport impacts = m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs);
   if (std::getenv("WEFT_DEBUG")) {
     Real strainAfter = 0;
     for (std::size_t e = 0; e < m_space.edges.size(); ++e) {
       strainAfter = std::max(strainAfter, (m_space.x[m_space.edges[e][1]] - m_space.x[m_space.edges[e][0]]).norm() / m_space.restLengths[e] - 1);
     }
+    Real faceDepth = 0;
+    for (std::size_t c = 0; c < m_contacts.firstPair; ++c) {
+      const Contact& contact = m_contacts.contacts[c];
+      if (contact.kind != ContactKind::FaceCollider) continue;
+      Vec3Array copy = m_space.x, vcopy = m_space.v;
+      Vec3 normal;
+      faceDepth = std::max(faceDepth, pushFaceOut(m_contacts.cores[contact.core], contact.normal, m_colliders[contact.collider].end.pose, {contact.vertices[0], contact.vertices[1], contact.vertices[2]}, m_space.inverseMass, copy, vcopy, 1 / h, normal));
+    }
+    std::fprintf(stderr, "end face depth %.3e selfimpacts %u\n", faceDepth, impacts.impacts);
     std::fprintf(stderr, "substep t=%.4f contacts %zu (pairs %zu) project it %d over %u viol %u strain %.4f -> impacts %u zones %u frozen %u collider %u strain %.4f\n",
                  t, m_contacts.size(), m_contacts.size() - m_contacts.firstPair, projected.iterations, projected.edgesOverLimit, projected.contactsViolated,
                  strainAfterProject, impacts.impacts, impacts.impactZones, impacts.frozenVertices, impacts.colliderCorrections, strainAfter);

@@ -227,12 +227,16 @@ TEST(StrainLimitWorld, AHeavyPadOnALightPinnedSheetStaysWithinTheLimit) {
 
 
 // A 1 m strip of soft cloth (a tenth of cotton's stretch stiffness), 8 cm wide, hanging from its
-// top edge with a 50 g bar sewn into its bottom edge: the load stretches the material far past
+// top edge with a 50 g bar sewn into its bottom edge: the load would stretch the material far past
 // the 10 % limit, so the limit must hold it on every mesh, however fine. `segments` along its
-// length; `staticLoad` starts it stretched and at rest under the load (the projection alone holds
-// it), otherwise it falls from its rest shape with the default dynamics. Returns the largest
-// strain over 3 s.
-Real loadedStripMaxStrain(Index segments, bool staticLoad) {
+// length; it falls from its rest shape with the default dynamics for 4 s. Returns the largest
+// strain over the run (the dynamics) and at its end, under the static load (the soft material
+// keeps chattering against the limit, so the end is loaded but not at rest).
+struct StripStrain {
+  Real dynamic = 0, loaded = 0;
+};
+
+StripStrain loadedStrip(Index segments) {
   GridSettings grid;
   grid.columns = 3;
   grid.rows = segments + 1;
@@ -246,35 +250,32 @@ Real loadedStripMaxStrain(Index segments, bool staticLoad) {
   settings.material.weftStretchStiffness *= 0.1;
   settings.material.shearStiffness *= 0.1;
   settings.selfCollision = false;
+  settings.sleep.enabled = false;
   settings.vertexMasses = model->vertexMasses(settings.material.arealDensity);
   for (Index c = 0; c < 3; ++c) settings.vertexMasses[c] += 0.05 / 3;  // the bar, bottom row
   for (Index c = 0; c < 3; ++c) settings.pinnedVertices.push_back(segments * 3 + c);
   World world;
-  const ClothId cloth = world.createCloth(model, settings).value();
-  if (staticLoad) {
-    // Start stretched to 30 % and at rest: the projection brings it back and holds it.
-    std::vector<Vec3> x(model->restPositions().begin(), model->restPositions().end());
-    for (Vec3& p : x) p.y() = 1.0 - 1.3 * (1.0 - p.y());
-    for (Index c = 0; c < 3; ++c) x[segments * 3 + c].y() = 1.0;
-    EXPECT_TRUE(world.setState(cloth, x, std::vector<Vec3>(x.size(), Vec3::Zero())).ok());
-  }
-  Real maxStrain = 0;
-  for (int frame = 0; frame < 180; ++frame) {
+  (void)world.createCloth(model, settings).value();
+  StripStrain strain;
+  for (int frame = 0; frame < 240; ++frame) {
     EXPECT_FALSE(hasFlag(world.step(kStep), StepStatus::RolledBack)) << "frame " << frame;
-    if (!staticLoad || frame > 0) maxStrain = std::max(maxStrain, world.stats().maxStrain);
+    strain.dynamic = std::max(strain.dynamic, world.stats().maxStrain);
   }
-  return maxStrain;
+  strain.loaded = world.stats().maxStrain;
+  return strain;
 }
 
 TEST(StrainLimitWorld, AFineStripUnderASustainedLoadStaysWithinTheLimitAtEveryResolution) {
   for (Index segments : {10, 20, 40, 80}) {
-    for (bool staticLoad : {true, false}) {
-      const Real strain = loadedStripMaxStrain(segments, staticLoad);
-      std::printf("[strain] strip of %u segments, %s: max strain %.4f\n", segments,
-                  staticLoad ? "static" : "falling", strain);
-      EXPECT_LE(strain, kAllowed) << segments << " segments, " << (staticLoad ? "static" : "falling");
-    }
+    const StripStrain strain = loadedStrip(segments);
+    std::printf("[strain] strip of %u segments: max strain %.4f over the fall, %.4f at the end\n",
+                segments, strain.dynamic, strain.loaded);
+    EXPECT_LE(strain.dynamic, kAllowed) << segments << " segments";
+    EXPECT_LE(strain.loaded, kAllowed) << segments << " segments";
+    // The load does stretch it to the limit: without one the strip would pass it.
+    EXPECT_GT(strain.loaded, 0.09) << segments << " segments";
   }
 }
+
 }  // namespace
 }  // namespace weft

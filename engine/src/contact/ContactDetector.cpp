@@ -20,6 +20,12 @@ constexpr Real kPressedShell = 0.01;
 // A face within this fraction of the thickness beyond its reach at the substep start rests on
 // the body: it takes friction on its whole displacement.
 constexpr Real kRestingFaceShell = 0.01;
+// Share of the overlap below the thickness a pair's projection removes in one substep (BFA02
+// use 0.1 for their proximity repulsion).
+constexpr Real kRepulsionRate = 0.1;
+// A pair that passed through itself within the substep is put back on its side this share of its
+// thickness apart (the impact stage's separation).
+constexpr Real kImpactSeparation = 0.25;
 // Feature pairs per parallel block: a closest-point test costs ~50–100 ns, so 128 pairs are
 // 5–15 µs of work, above a fork/join.
 constexpr TaskSystem::Index kGrainFeaturePairs = 128;
@@ -62,7 +68,7 @@ void ContactDetector::selectNear(const ContactSpace& space,
         if (space.inverseMass[i] != 0) box.expand(collider.carry(space.startX[i]));
       }
     }
-    if (mayTouch(collider.shape, box, reach)) {
+    if (!m_skip || mayTouch(collider.shape, box, reach)) {
       m_near.push_back(k);
       ++counts.colliderPairsTested;
     } else {
@@ -145,7 +151,7 @@ void ContactDetector::constrain(const ContactSpace& space,
         continue;
       }
       out.push_back({corner, support.normal, speed - support.normal.dot(space.startV[corner]),
-                     kInvalidIndex});
+                     kFaceCornerConstraint});
       m_constrained[corner] = 1;
     }
   }
@@ -163,7 +169,7 @@ void ContactDetector::detect(const ContactSpace& space, std::span<const Collider
   selectNear(space, colliders, space.x, margin, counts);
   if (!m_near.empty()) {
     detectColliderVertices(space, colliders, solveImpulses, constrainedCollider, margin, set);
-    detectColliderFaces(space, colliders, set);
+    detectColliderFaces(space, colliders, solveImpulses, constrainedCollider, margin, set);
   }
   set.firstPair = set.contacts.size();
   if (pairs) detectPairs(space, set);
@@ -207,7 +213,9 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
 
 void ContactDetector::detectColliderFaces(const ContactSpace& space,
                                           std::span<const ColliderFrame> colliders,
-                                          ContactSet& set) {
+                                          std::span<const Real> solveImpulses,
+                                          std::span<const Index> constrainedCollider,
+                                          Real margin, ContactSet& set) {
   WEFT_PROFILE_ZONE("face contacts");
   for (Index k : m_near) {
     const ColliderFrame& collider = colliders[k];
@@ -217,16 +225,19 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
     const Pose& startPose = collider.start.pose;
     for (Index t = 0; t < Index(space.triangles.size()); ++t) {
       const std::array<Index, 3>& corner = space.triangles[t];
+      if (!space.faceContacts(corner[0])) continue;
       if (space.inverseMass[corner[0]] == 0 && space.inverseMass[corner[1]] == 0 &&
           space.inverseMass[corner[2]] == 0) {
         continue;
       }
-      // Start and end: a face may cross a thin body within one substep.
+      // Start and end: a face may cross a thin body within one substep. With the margin: the
+      // projection may move a face that far towards the body.
       Aabb box = Aabb::empty();
       for (Index i : corner) {
         box.expand(space.x[i]);
         box.expand(space.startX[i]);
       }
+      box.inflate(margin);
       if (!box.overlaps(body)) continue;
       const Real allowance = thicknessOf(space, corner[0]);
       m_bodyCores.clear();
@@ -240,6 +251,7 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
         path.expand(startLocal[j]);
         path.expand(endPose.toLocal(space.x[corner[j]]));
       }
+      path.inflate(margin);
       if (mesh) {
         Aabb near = path;
         near.inflate(0.5 * allowance);
@@ -264,6 +276,15 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
         contact.collider = k;
         contact.core = Index(set.cores.size());
         contact.resting = before.distance <= core.reach + kRestingFaceShell * allowance;
+        // The solve's support of a face resting on the body: its corners' constraints, averaged
+        // as the centroid where friction acts takes them.
+        if (!solveImpulses.empty()) {
+          for (Index i : corner) {
+            if (constrainedCollider[i] == kFaceCornerConstraint) {
+              contact.solveImpulse += std::max<Real>(0, solveImpulses[i]) / 3;
+            }
+          }
+        }
         set.cores.push_back(core);
         set.contacts.push_back(contact);
       }
@@ -274,126 +295,117 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
 void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
   Real maxThickness = 0;
   for (const ContactOwner& owner : space.owners) maxThickness = std::max(maxThickness, owner.thickness);
-  m_features.find(space, space.startX, space.x, maxThickness);
+  m_features.find(space, space.startX, space.x, kPairReach * maxThickness);
   const auto& vertexTriangle = m_features.vertexTriangle();
-  const auto& edgeEdge = m_features.edgeEdge();
+  const auto& edgeEdgePairs = m_features.edgeEdge();
   const Index vertexTriangleCount = Index(vertexTriangle.size());
-  const Index total = vertexTriangleCount + Index(edgeEdge.size());
+  const Index total = vertexTriangleCount + Index(edgeEdgePairs.size());
   const Vec3Array& x0 = space.startX;
   const Vec3Array& x1 = space.x;
-  // Orients `normal` to the side p − q had at the start (with the same weights), where the
-  // cloths are free of crossings.
-  auto orient = [&](const std::array<Index, 4>& vertices, const std::array<Real, 4>& weights,
-                    Vec3 normal) {
-    Vec3 startGap = Vec3::Zero();
-    for (int k = 0; k < 4; ++k) startGap += weights[k] * x0[vertices[k]];
-    return startGap.dot(normal) < 0 ? Vec3(-normal) : normal;
-  };
-  // A pair farther than its thickness at both ends of the motion may still have passed through
-  // itself within it (a layer falling through another in one substep). A change of side of the
-  // vertex against the face's plane, or of the edges against each other, is the cheap sign; the
-  // swept test decides, and the contact takes the side the pair came from.
-  auto crossedVertexFace = [&](Index vertex, const std::array<Index, 3>& c, Real thickness,
-                               Contact& contact) -> bool {
+  // The contact of a pair (see the file comment): closer than its thickness at the start, with
+  // the start's closest points, whose side x₀ (free of crossings) gives (Bridson, Fedkiw &
+  // Anderson 2002's proximity); or passed through itself within the motion (a change of side of
+  // the vertex against the face's plane, or of the edges against each other, is the cheap sign,
+  // the swept test decides), with the point of the hit and the side it came from. A pair that
+  // only ends close is left to the next substep's start, where its side is known.
+  auto vertexFace = [&](Index vertex, Index triangle, Contact& contact) -> bool {
+    const std::array<Index, 3>& c = space.triangles[triangle];
+    const Real thickness = space.pairThickness(vertex, c[0]);
+    const TriangleClosestPoint start = closestPointOnTriangle(x0[vertex], x0[c[0]], x0[c[1]], x0[c[2]]);
     const Vec3 n0 = (x0[c[1]] - x0[c[0]]).cross(x0[c[2]] - x0[c[0]]);
     const Vec3 n1 = (x1[c[1]] - x1[c[0]]).cross(x1[c[2]] - x1[c[0]]);
-    if (!(n0.dot(x0[vertex] - x0[c[0]]) * n1.dot(x1[vertex] - x1[c[0]]) <= 0)) return false;
-    const std::optional<VertexTriangleImpact> hit = sweptVertexTriangle(
-        x0[vertex], x1[vertex], {x0[c[0]], x0[c[1]], x0[c[2]]}, {x1[c[0]], x1[c[1]], x1[c[2]]});
-    if (!hit) return false;
+    const bool sideChanged = n0.dot(x0[vertex] - x0[c[0]]) * n1.dot(x1[vertex] - x1[c[0]]) <= 0;
+    if (!(start.distance < kPairReach * thickness) && !sideChanged) return false;
+    // Neighbours in the material (within the pairs' reach at rest): the elastic forces keep
+    // them apart.
+    if (space.owner[vertex] == space.owner[c[0]] &&
+        closestPointOnTriangle(space.rest[vertex], space.rest[c[0]], space.rest[c[1]],
+                               space.rest[c[2]]).distance < kPairReach * thickness) {
+      return false;
+    }
     contact.kind = ContactKind::VertexFace;
     contact.vertices = {vertex, c[0], c[1], c[2]};
-    contact.weights = {1, -hit->barycentric[0], -hit->barycentric[1], -hit->barycentric[2]};
-    contact.normal = orient(contact.vertices, contact.weights, hit->normal);
-    contact.gap = 0;
     contact.separation = thickness;
     contact.friction = space.pairFriction(vertex, c[0]);
-    return true;
-  };
-  auto crossedEdgeEdge = [&](const std::array<Index, 2>& p, const std::array<Index, 2>& q,
-                             Real thickness, Contact& contact) -> bool {
-    const Vec3 n0 = (x0[p[1]] - x0[p[0]]).cross(x0[q[1]] - x0[q[0]]);
-    const Vec3 n1 = (x1[p[1]] - x1[p[0]]).cross(x1[q[1]] - x1[q[0]]);
-    if (!(n0.dot(x0[p[0]] - x0[q[0]]) * n1.dot(x1[p[0]] - x1[q[0]]) <= 0)) return false;
-    const std::optional<EdgeEdgeImpact> hit =
-        sweptEdgeEdge({x0[p[0]], x0[p[1]]}, {x1[p[0]], x1[p[1]]}, {x0[q[0]], x0[q[1]]},
-                      {x1[q[0]], x1[q[1]]});
-    if (!hit) return false;
-    const Real s = hit->firstParameter, u = hit->secondParameter;
-    contact.kind = ContactKind::EdgeEdge;
-    contact.vertices = {p[0], p[1], q[0], q[1]};
-    contact.weights = {1 - s, s, -(1 - u), -u};
-    contact.normal = orient(contact.vertices, contact.weights, hit->normal);
-    contact.gap = 0;
-    contact.separation = thickness;
-    contact.friction = space.pairFriction(p[0], q[0]);
-    return true;
-  };
-  auto test = [&](Index pair, Contact& contact) -> bool {
-    if (pair < vertexTriangleCount) {
-      const auto& [vertex, triangle] = vertexTriangle[pair];
-      const std::array<Index, 3>& c = space.triangles[triangle];
-      const Real thickness = space.pairThickness(vertex, c[0]);
-      const TriangleClosestPoint start = closestPointOnTriangle(x0[vertex], x0[c[0]], x0[c[1]], x0[c[2]]);
-      const TriangleClosestPoint end = closestPointOnTriangle(x1[vertex], x1[c[0]], x1[c[1]], x1[c[2]]);
-      if (!(std::min(start.distance, end.distance) < thickness)) {
-        return crossedVertexFace(vertex, c, thickness, contact);
-      }
-      if (space.owner[vertex] == space.owner[c[0]] &&
-          closestPointOnTriangle(space.rest[vertex], space.rest[c[0]], space.rest[c[1]],
-                                 space.rest[c[2]]).distance < thickness) {
-        return false;  // neighbours in the material: the elastic forces keep them apart
-      }
-      const bool atStart = start.distance <= end.distance;
-      const TriangleClosestPoint& closest = atStart ? start : end;
-      const Vec3Array& x = atStart ? x0 : x1;
-      contact.kind = ContactKind::VertexFace;
-      contact.vertices = {vertex, c[0], c[1], c[2]};
-      contact.weights = {1, -closest.barycentric[0], -closest.barycentric[1], -closest.barycentric[2]};
-      Vec3 normal = x[vertex] - closest.point;
-      if (closest.distance < 1e-9 * thickness) {
-        normal = (x[c[1]] - x[c[0]]).cross(x[c[2]] - x[c[0]]);
-      }
-      if (normal.norm() == 0) return false;
-      contact.normal = orient(contact.vertices, contact.weights, normal.normalized());
-      contact.gap = std::min(start.distance, end.distance);
-      contact.separation = thickness;
-      contact.friction = space.pairFriction(vertex, c[0]);
-      contact.resting = start.distance < thickness;
+    contact.resting = start.distance < thickness;
+    contact.gap = start.distance;
+    if (!(start.distance < kPairReach * thickness)) {
+      const std::optional<VertexTriangleImpact> hit = sweptVertexTriangle(
+          x0[vertex], x1[vertex], {x0[c[0]], x0[c[1]], x0[c[2]]}, {x1[c[0]], x1[c[1]], x1[c[2]]});
+      if (!hit) return false;
+      contact.weights = {1, -hit->barycentric[0], -hit->barycentric[1], -hit->barycentric[2]};
+      contact.normal = hit->normal;
+      contact.gap = 0;
+      contact.separation = kImpactSeparation * thickness;
       return true;
     }
-    const auto& [firstEdge, secondEdge] = edgeEdge[pair - vertexTriangleCount];
+    contact.weights = {1, -start.barycentric[0], -start.barycentric[1], -start.barycentric[2]};
+    Vec3 normal = x0[vertex] - start.point;
+    if (start.distance < 1e-9 * thickness) normal = n0;
+    if (normal.norm() == 0) return false;
+    contact.normal = normal.normalized();
+    return true;
+  };
+  auto edgeEdge = [&](Index firstEdge, Index secondEdge, Contact& contact) -> bool {
     const std::array<Index, 2>& p = space.edges[firstEdge];
     const std::array<Index, 2>& q = space.edges[secondEdge];
     const Real thickness = space.pairThickness(p[0], q[0]);
     const SegmentClosestPoints start = closestPointsOnSegments(x0[p[0]], x0[p[1]], x0[q[0]], x0[q[1]]);
-    const SegmentClosestPoints end = closestPointsOnSegments(x1[p[0]], x1[p[1]], x1[q[0]], x1[q[1]]);
-    if (!(std::min(start.distance, end.distance) < thickness)) {
-      return crossedEdgeEdge(p, q, thickness, contact);
-    }
+    const Vec3 n0 = (x0[p[1]] - x0[p[0]]).cross(x0[q[1]] - x0[q[0]]);
+    const Vec3 n1 = (x1[p[1]] - x1[p[0]]).cross(x1[q[1]] - x1[q[0]]);
+    const bool sideChanged = n0.dot(x0[p[0]] - x0[q[0]]) * n1.dot(x1[p[0]] - x1[q[0]]) <= 0;
+    if (!(start.distance < kPairReach * thickness) && !sideChanged) return false;
     if (space.owner[p[0]] == space.owner[q[0]] &&
         closestPointsOnSegments(space.rest[p[0]], space.rest[p[1]], space.rest[q[0]],
-                                space.rest[q[1]]).distance < thickness) {
+                                space.rest[q[1]]).distance < kPairReach * thickness) {
       return false;
     }
-    const bool atStart = start.distance <= end.distance;
-    const SegmentClosestPoints& closest = atStart ? start : end;
-    const Vec3Array& x = atStart ? x0 : x1;
-    const Real s = closest.firstParameter, u = closest.secondParameter;
     contact.kind = ContactKind::EdgeEdge;
     contact.vertices = {p[0], p[1], q[0], q[1]};
-    contact.weights = {1 - s, s, -(1 - u), -u};
-    Vec3 normal = ((1 - s) * x[p[0]] + s * x[p[1]]) - ((1 - u) * x[q[0]] + u * x[q[1]]);
-    if (closest.distance < 1e-9 * thickness) {
-      normal = (x[p[1]] - x[p[0]]).cross(x[q[1]] - x[q[0]]);
-    }
-    if (normal.norm() == 0) return false;
-    contact.normal = orient(contact.vertices, contact.weights, normal.normalized());
-    contact.gap = std::min(start.distance, end.distance);
     contact.separation = thickness;
     contact.friction = space.pairFriction(p[0], q[0]);
     contact.resting = start.distance < thickness;
+    contact.gap = start.distance;
+    if (!(start.distance < kPairReach * thickness)) {
+      const std::optional<EdgeEdgeImpact> hit =
+          sweptEdgeEdge({x0[p[0]], x0[p[1]]}, {x1[p[0]], x1[p[1]]}, {x0[q[0]], x0[q[1]]},
+                        {x1[q[0]], x1[q[1]]});
+      if (!hit) return false;
+      const Real s = hit->firstParameter, u = hit->secondParameter;
+      contact.weights = {1 - s, s, -(1 - u), -u};
+      contact.normal = hit->normal;
+      contact.gap = 0;
+      contact.separation = kImpactSeparation * thickness;
+      return true;
+    }
+    const Real s = start.firstParameter, u = start.secondParameter;
+    contact.weights = {1 - s, s, -(1 - u), -u};
+    Vec3 normal = ((1 - s) * x0[p[0]] + s * x0[p[1]]) - ((1 - u) * x0[q[0]] + u * x0[q[1]]);
+    if (start.distance < 1e-9 * thickness) normal = n0;
+    if (normal.norm() == 0) return false;
+    contact.normal = normal.normalized();
     return true;
+  };
+  auto test = [&](Index pair, Contact& contact) -> bool {
+    const bool found =
+        pair < vertexTriangleCount
+            ? vertexFace(vertexTriangle[pair][0], vertexTriangle[pair][1], contact)
+            : edgeEdge(edgeEdgePairs[pair - vertexTriangleCount][0],
+                       edgeEdgePairs[pair - vertexTriangleCount][1], contact);
+    if (found && contact.resting) {
+      // A pair that starts the substep closer than its thickness need only part of the way back
+      // to it in one substep (Bridson, Fedkiw & Anderson 2002's repulsion rate), never closer
+      // than it started: folds pressed tighter than two thicknesses (a sandwiched layer) would
+      // otherwise ask for positions no projection can reach.
+      Real startGap = 0;
+      Vec3 start = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) start += contact.weights[k] * x0[contact.vertices[k]];
+      startGap = std::max<Real>(0, contact.normal.dot(start));
+      if (startGap < contact.separation) {
+        contact.separation = startGap + kRepulsionRate * (contact.separation - startGap);
+      }
+    }
+    return found;
   };
   WEFT_PROFILE_ZONE("narrow phase");
   if (!m_workerContacts || total <= kGrainFeaturePairs) {

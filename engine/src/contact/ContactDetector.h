@@ -35,14 +35,23 @@
 
 namespace weft {
 
+/// Pairs of cloth features this many thicknesses apart at the substep start are contacts: one
+/// that approaches by up to a thickness within the substep is caught at the start, where its side
+/// is known. Features that close at rest are neighbours in the material and never a contact.
+inline constexpr Real kPairReach = 2;
+
 /// A constraint of the implicit solve: the velocity change of `vertex` along `normal` is fixed
 /// to `normalChange` (m/s), so that its predicted motion ends at the contact distance.
 struct SolveConstraint {
   Index vertex = 0;  ///< of the contact space
   Vec3 normal = Vec3::Zero();
   Real normalChange = 0;
-  Index collider = kInvalidIndex;  ///< the collider, or kInvalidIndex for a face's corner
+  Index collider = kInvalidIndex;  ///< the collider, or kFaceCornerConstraint
 };
+
+/// SolveConstraint::collider of a face corner's constraint, and the per-vertex marker detect()
+/// reads for it.
+inline constexpr Index kFaceCornerConstraint = kInvalidIndex - 1;
 
 /// A face point resting on a core at the end of a substep, whose corners the next solve holds.
 struct FaceSupport {
@@ -62,6 +71,8 @@ class ContactDetector {
  public:
   /// Builds the broad-phase tables of `space` (when its cloths change).
   void build(const ContactSpace& space, TaskSystem* tasks);
+  /// `skip`: WorldSettings::skipUnneededStages; off, every collider is tested, near or not.
+  void setSkipping(bool skip) { m_skip = skip; }
   /// Leaves of the broad phase keep their boxes while their triangles move less than this (m).
   void setRefitMargin(Real margin) { m_features.setRefitMargin(margin); }
   /// The solve's constraints for the predicted motion x₀ + h v₀ (space.startX, startV) against
@@ -71,8 +82,8 @@ class ContactDetector {
                  std::span<const FaceSupport> supports, std::vector<SolveConstraint>& out,
                  DetectionCounts& counts);
   /// The contacts of the solved motion space.startX → space.x into `set` (cleared first).
-  /// `solveImpulses` (m/s per vertex) and `constrainedCollider` (per vertex, kInvalidIndex:
-  /// none) say what the solve's constraints did. `pairs`: detect cloth pairs (false when no
+  /// `solveImpulses` (m/s per vertex) and `constrainedCollider` (per vertex: the collider,
+  /// kFaceCornerConstraint, or kInvalidIndex: none) say what the solve's constraints did. `pairs`: detect cloth pairs (false when no
   /// cloth can touch itself or another this substep). `margin` (m): how far beyond its thickness
   /// a vertex may be from a collider and still be a contact.
   void detect(const ContactSpace& space, std::span<const ColliderFrame> colliders,
@@ -88,6 +99,8 @@ class ContactDetector {
                               std::span<const Index> constrainedCollider, Real margin,
                               ContactSet& set);
   void detectColliderFaces(const ContactSpace& space, std::span<const ColliderFrame> colliders,
+                           std::span<const Real> solveImpulses,
+                           std::span<const Index> constrainedCollider, Real margin,
                            ContactSet& set);
   void detectPairs(const ContactSpace& space, ContactSet& set);
   // The colliders whose box comes near the cloth's motion, into m_near; counts both kinds.
@@ -95,6 +108,7 @@ class ContactDetector {
                   const Vec3Array& end, Real margin, DetectionCounts& counts);
 
   TaskSystem* m_tasks = nullptr;
+  bool m_skip = true;
   FeaturePairs m_features;
   std::vector<Index> m_near;  // colliders near the cloth this pass
   struct FoundContact {

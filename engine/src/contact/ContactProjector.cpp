@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <cstdio>
+#include <cstdlib>
 
 namespace weft {
 namespace {
@@ -13,6 +15,15 @@ namespace {
 // projection (its normal velocity is made inelastic): the projection leaves contacts at exactly
 // the thickness, a body's curvature a little beyond.
 constexpr Real kOnSurfaceShell = 0.01;
+// Sweeps in which friction acts: friction holds what the solve moved, and the sweeps after it
+// satisfy the strain limit and the separations, which friction must not resist (a cloth pulled
+// over a body at its limit slides on it, whatever the friction).
+constexpr int kFrictionSweeps = 1;
+// Sweeps in which the edges follow the leader (only the end farther from the pins moves): the first
+// brings a hanging chain within its limit from the pins down in one pass; the later ones share
+// each correction by mass, which lets a load from the far side (a body pushing the cloth's middle)
+// draw cloth in from the pins.
+constexpr int kFollowTheLeaderSweeps = 1;
 // m: face points closer than this outside their reach still count as touching (a point the
 // projection just put at the reach is at −1e-17).
 constexpr Real kTouching = 1e-9;
@@ -40,6 +51,32 @@ Vec3 frictionCorrection(const Vec3& slip, const Vec3& applied, Real normal, Real
   return coulombFriction(free, normal, friction) - free;
 }
 
+// Below this fraction of the free weight sum, an edge held at both ends along itself is left to
+// the contacts (it cannot be shortened across the surfaces it rests on).
+constexpr Real kSmallestHeldWeight = 1e-3;
+
+// An edge's weight sum when its ends may move only across their contact normals (zero normal:
+// free): w (1 − (n·d)²) per end, d the edge's direction.
+Real heldWeight(Real weightA, Real weightB, const Vec3& normalA, const Vec3& normalB,
+                const Vec3& direction) {
+  const Real alongA = normalA.dot(direction), alongB = normalB.dot(direction);
+  const Real held = weightA * (1 - alongA * alongA) + weightB * (1 - alongB * alongB);
+  return held > kSmallestHeldWeight * (weightA + weightB) ? held : 0;
+}
+
+// The fraction of a held correction that brings the edge vector `delta`, changed by `change`, to
+// length `longest` (the first root), or where it is shortest when it cannot get that short: the
+// correction is linearised, and across a normal nearly along the edge it would carry an end far
+// past the edge's shortest point.
+Real heldStepFraction(const Vec3& delta, const Vec3& change, Real longest) {
+  const Real a = change.squaredNorm(), b = delta.dot(change);
+  if (!(a > 0) || !(b < 0)) return 0;
+  const Real c = delta.squaredNorm() - longest * longest;
+  const Real discriminant = b * b - a * c;
+  const Real fraction = discriminant >= 0 ? (-b - std::sqrt(discriminant)) / a : -b / a;
+  return std::min<Real>(1, fraction);
+}
+
 }  // namespace
 
 ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet& set,
@@ -50,6 +87,15 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   ProjectionReport report;
   const std::size_t count = set.size();
   m_pushed.assign(count, 0);
+  m_visited.assign(count, 0);
+  m_solved = space.x;
+  m_touching.assign(space.vertexCount(), 0);
+  m_surfaceNormal.assign(space.vertexCount(), Vec3::Zero());
+  for (const Contact& contact : set.contacts) {
+    for (Index vertex : contact.vertices) {
+      if (vertex != kInvalidIndex) m_touching[vertex] = 1;
+    }
+  }
   m_friction.assign(count, Vec3::Zero());
   m_lastOutside.resize(count);
   for (std::size_t c = 0; c < set.firstPair; ++c) {
@@ -61,11 +107,39 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   const Real inverseStep = 1 / h;
   for (int iteration = 0;; ++iteration) {
     const bool backward = iteration % 2 == 1;
+    m_frictionOn = iteration < kFrictionSweeps;
+    m_followTheLeader = iteration < kFollowTheLeaderSweeps;
     const Index over = sweepEdges(space, inverseStep, settings.strainTolerance, backward);
     const Index violated =
         sweepContacts(space, set, colliders, h, settings.contactTolerance, backward);
     report.edgesOverLimit = over;
     report.contactsViolated = violated;
+    if (std::getenv("WEFT_DEBUG2") && (iteration < 3 || iteration % 32 == 0 || iteration > 125)) {
+      int kinds[4] = {0, 0, 0, 0};
+      Real worst = 0;
+      for (std::size_t c = 0; c < set.size(); ++c) {
+        const Contact& contact = set.contacts[c];
+        if (contact.kind == ContactKind::VertexFace || contact.kind == ContactKind::EdgeEdge) {
+          Vec3 gap = Vec3::Zero();
+          for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
+          const Real short_ = contact.separation - contact.normal.dot(gap);
+          if (short_ > 3e-5) { kinds[int(contact.kind)]++; worst = std::max(worst, short_); }
+        }
+      }
+      std::fprintf(stderr, "   it %d over %u viol %u  vf %d ee %d worst %.2e (set %zu)\n", iteration, over, violated, kinds[2], kinds[3], worst, set.size());
+      if (iteration > 126) {
+        int shown = 0;
+        for (std::size_t c = set.firstPair; c < set.size() && shown < 12; ++c) {
+          const Contact& contact = set.contacts[c];
+          Vec3 gap = Vec3::Zero(), gap0 = Vec3::Zero();
+          for (int k = 0; k < 4; ++k) { gap += contact.weights[k] * space.x[contact.vertices[k]]; gap0 += contact.weights[k] * space.startX[contact.vertices[k]]; }
+          const Real short_ = contact.separation - contact.normal.dot(gap);
+          if (short_ < 1e-3) continue;
+          ++shown;
+          std::fprintf(stderr, "      c%zu kind %d v %u %u %u %u w %.2f %.2f %.2f %.2f sep %.2e now %.2e start %.2e |gap0| %.2e resting %d pushed %.2e\n", c, int(contact.kind), contact.vertices[0], contact.vertices[1], contact.vertices[2], contact.vertices[3], contact.weights[0], contact.weights[1], contact.weights[2], contact.weights[3], contact.separation, contact.normal.dot(gap), contact.normal.dot(gap0), gap0.norm(), contact.resting, m_pushed[c]);
+        }
+      }
+    }
     if (over == 0 && violated == 0) break;
     report.iterations = iteration + 1;
     if (report.iterations == settings.maxIterations) {
@@ -79,6 +153,9 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
       break;
     }
   }
+  // The projection's whole displacement becomes the velocity's change, so v stays the substep's
+  // average velocity (x − x₀) / h; then contacts keep no velocity into each other.
+  for (Index i = 0; i < space.vertexCount(); ++i) space.v[i] += (space.x[i] - m_solved[i]) * inverseStep;
   report.colliderContacts = finish(space, set, colliders, h, supports);
   return report;
 }
@@ -87,22 +164,60 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real inverseStep, Real t
                                    bool backward) {
   const Index edgeCount = Index(space.edges.size());
   Index over = 0;
+  // The tethers first: each moves its vertex only (the anchor is a pin).
+  const Index tethered = std::min<Index>(space.vertexCount(), Index(space.tetherAnchor.size()));
+  for (Index i = 0; i < tethered; ++i) {
+    const Index anchor = space.tetherAnchor[i];
+    if (anchor == kInvalidIndex || space.inverseMass[i] == 0) continue;
+    const Vec3 delta = space.x[i] - space.x[anchor];
+    const Real length = delta.norm();
+    const Real longest = space.tetherLength[i];
+    if (!(length > longest)) continue;
+    over += length > longest * (1 + tolerance);
+    const Vec3 shift = ((longest - length) / length) * delta;
+    space.x[i] += shift;
+  }
+  const bool ordered = space.edgeOrder.size() == space.edges.size();
+  const bool anchored = space.anchorDistance.size() == space.x.size() && m_followTheLeader;
   for (Index k = 0; k < edgeCount; ++k) {
-    const Index e = backward ? edgeCount - 1 - k : k;
+    const Index slot = backward ? edgeCount - 1 - k : k;
+    const Index e = ordered ? space.edgeOrder[slot] : slot;
     const Real longest = space.longest[e];
     const Index a = space.edges[e][0], b = space.edges[e][1];
     const Vec3 delta = space.x[b] - space.x[a];
     const Real length = delta.norm();
     if (!(length > longest)) continue;
-    const Real weightA = space.inverseMass[a], weightB = space.inverseMass[b];
-    const Real weightSum = weightA + weightB;
-    if (weightSum == 0) continue;  // both ends pinned: nothing can shorten it
+    Real weightA = space.inverseMass[a], weightB = space.inverseMass[b];
+    if (weightA + weightB == 0) continue;  // both ends pinned: nothing can shorten it
     over += length > longest + tolerance * space.restLengths[e];
-    const Vec3 impulse = ((length - longest) / (weightSum * length)) * delta;
+    const Vec3& normalA = m_surfaceNormal[a];
+    const Vec3& normalB = m_surfaceNormal[b];
+    if (!normalA.isZero() || !normalB.isZero()) {
+      // An end resting on a collider slides on it: its share of the correction loses the part
+      // along the surface's normal, which the contact would undo (GS would then zig-zag along a
+      // curved body), and the step is cut where it brings the edge to its limit.
+      const Vec3 direction = delta / length;
+      const Real held = heldWeight(weightA, weightB, normalA, normalB, direction);
+      if (held == 0) continue;
+      const Vec3 impulse = ((length - longest) / held) * direction;
+      Vec3 shiftA = weightA * impulse, shiftB = -weightB * impulse;
+      shiftA -= normalA.dot(shiftA) * normalA;
+      shiftB -= normalB.dot(shiftB) * normalB;
+      const Real fraction = heldStepFraction(delta, shiftB - shiftA, longest);
+      space.x[a] += fraction * shiftA;
+      space.x[b] += fraction * shiftB;
+      continue;
+    }
+    // Follow the leader: the end nearer the pins stays, unless the other cannot move or either
+    // end touches something (then the contact, not the pins, carries it: both ends move).
+    if (anchored && !m_touching[a] && !m_touching[b]) {
+      const Real nearA = space.anchorDistance[a], nearB = space.anchorDistance[b];
+      if (nearA < nearB && weightB > 0) weightA = 0;
+      if (nearB < nearA && weightA > 0) weightB = 0;
+    }
+    const Vec3 impulse = ((length - longest) / ((weightA + weightB) * length)) * delta;
     space.x[a] += weightA * impulse;
-    space.v[a] += inverseStep * weightA * impulse;
     space.x[b] -= weightB * impulse;
-    space.v[b] -= inverseStep * weightB * impulse;
   }
   return over;
 }
@@ -128,7 +243,8 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
         depth = projectPair(space, c, contact, h);
         break;
     }
-    violated += depth > tolerance * contact.separation;
+    // A contact counts while it still moves its vertices (pushed out, or friction's stick).
+    violated += depth > tolerance * space.owners[space.owner[contact.vertices[0]]].thickness;
   }
   return violated;
 }
@@ -141,31 +257,40 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   Vec3& x = space.x[i];
   const ShapeContact before = queryPoint(collider.shape, x);
   Real depth = 0;
-  if (before.distance < thickness) {
-    depth = thickness - before.distance;
-    // Followed from where it was last outside, the body held at its end pose.
+  // Followed from where it was last outside, the body held at its end pose; on the first visit
+  // from the substep's start carried with the body, so that a vertex a fast or thin body passed
+  // through is found although it ends clear of it.
+  const bool firstVisit = !m_visited[index];
+  if (before.distance < thickness || firstVisit) {
     const Vec3 outside = keepOutsideFrom(collider.shape, m_lastOutside[index], x, thickness);
     const Vec3 shift = outside - x;
-    x = outside;
-    space.v[i] += shift / h;
-    m_pushed[index] += std::max<Real>(0, shift.dot(queryPoint(collider.shape, x).normal));
+    if (!shift.isZero()) {
+      depth = std::max<Real>(thickness - before.distance, shift.norm());
+      x = outside;
+      m_pushed[index] += std::max<Real>(0, shift.dot(queryPoint(collider.shape, x).normal));
+    }
+    m_visited[index] = 1;
   }
   m_lastOutside[index] = x;
-  if (!contact.resting || !(contact.friction > 0)) return depth;
+  {
+    // Resting on the body now: the edges slide the vertex on it (sweepEdges).
+    const ShapeContact on = queryPoint(collider.shape, x);
+    m_surfaceNormal[i] = on.distance < (1 + kOnSurfaceShell) * thickness ? on.normal : Vec3::Zero();
+  }
+  if (!m_frictionOn || !contact.resting || !(contact.friction > 0)) return depth;
   // Static and kinetic friction on the substep's displacement relative to the body.
   const ShapeContact on = queryPoint(collider.shape, x);
   if (!(on.distance < (1 + kOnSurfaceShell) * thickness)) return depth;
-  const Real normal = h * contact.solveImpulse + m_pushed[index];
+  const Real normal = h * contact.solveImpulse +
+                     std::max<Real>(0, on.normal.dot(x - m_solved[i]));
   Vec3 slip = x - collider.carry(space.startX[i]);
   slip -= slip.dot(on.normal) * on.normal;
   Vec3 applied = m_friction[index];
   applied -= applied.dot(on.normal) * on.normal;
   const Vec3 correction = frictionCorrection(slip, applied, normal, contact.friction);
-  const Vec3 shift = correction - applied;
-  x += shift;
-  space.v[i] += shift / h;
+  x += correction - applied;
   m_friction[index] = correction;
-  return depth;
+  return std::max(depth, (correction - applied).norm());
 }
 
 Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const Contact& contact,
@@ -173,9 +298,9 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   const std::array<Index, 3> corner{contact.vertices[0], contact.vertices[1], contact.vertices[2]};
   Vec3 normal = Vec3::Zero();
   const Real depth = pushFaceOut(set.cores[contact.core], contact.normal, collider.end.pose, corner,
-                                 space.inverseMass, space.x, space.v, 1 / h, normal);
+                                 space.inverseMass, space.x, space.v, 0, normal);
   m_pushed[index] += depth;
-  if (!contact.resting || !(contact.friction > 0)) return depth;
+  if (!m_frictionOn || !contact.resting || !(contact.friction > 0)) return depth;
   // Friction at the face's centroid over the corners that are not on the body themselves (those
   // take it as vertex contacts), with the body's normal where the face touches it.
   const Real thickness = space.owners[space.owner[corner[0]]].thickness;
@@ -203,7 +328,9 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   }
   const Real weight = pointInverseMass(b, corner, space.inverseMass);
   if (!(weight > 0)) return depth;
-  const Real budget = h * contact.solveImpulse + m_pushed[index];
+  Vec3 lifted = Vec3::Zero();
+  for (int j = 0; j < 3; ++j) lifted += b[j] * (space.x[corner[j]] - m_solved[corner[j]]);
+  const Real budget = h * contact.solveImpulse + std::max<Real>(0, normal.dot(lifted));
   Vec3 slip = Vec3::Zero();
   for (int j = 0; j < 3; ++j) slip += b[j] * (space.x[corner[j]] - collider.carry(space.startX[corner[j]]));
   slip -= slip.dot(normal) * normal;
@@ -212,12 +339,10 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   const Vec3 correction = frictionCorrection(slip, applied, budget, contact.friction);
   const Vec3 change = correction - applied;
   for (int j = 0; j < 3; ++j) {
-    const Vec3 shift = (b[j] * space.inverseMass[corner[j]] / weight) * change;
-    space.x[corner[j]] += shift;
-    space.v[corner[j]] += shift / h;
+    space.x[corner[j]] += (b[j] * space.inverseMass[corner[j]] / weight) * change;
   }
   m_friction[index] = correction;
-  return depth;
+  return std::max(depth, change.norm());
 }
 
 Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact,
@@ -227,21 +352,31 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
   Vec3 gap = Vec3::Zero();
   for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
   const Real shortfall = contact.separation - contact.normal.dot(gap);
+  // Moves the pair's sides relative to each other by `relativeChange`.
   const auto move = [&](const Vec3& relativeChange) {
     const Vec3 lambda = relativeChange / weight;
     for (int k = 0; k < 4; ++k) {
       const Index i = contact.vertices[k];
-      if (space.inverseMass[i] == 0) continue;
-      const Vec3 shift = (contact.weights[k] * inverseMass) * lambda;
-      space.x[i] += shift;
-      space.v[i] += shift / h;
+      if (space.inverseMass[i] > 0) space.x[i] += (contact.weights[k] * inverseMass) * lambda;
     }
   };
   if (shortfall > 0) {
     move(shortfall * contact.normal);
     m_pushed[index] += shortfall;
   }
-  if (!(contact.friction > 0) || !(m_pushed[index] > 0)) return std::max<Real>(0, shortfall);
+  // Friction acts only while the pair touches (the projection holds it at its separation).
+  if (!m_frictionOn || !(contact.friction > 0) ||
+      !(shortfall > -kOnSurfaceShell * contact.separation)) {
+    return std::max<Real>(0, shortfall);
+  }
+  // The budget: how far the projection has moved the pair apart along its normal in all.
+  Vec3 apart = Vec3::Zero();
+  for (int k = 0; k < 4; ++k) {
+    const Index i = contact.vertices[k];
+    apart += contact.weights[k] * (space.x[i] - m_solved[i]);
+  }
+  const Real budget = std::max<Real>(0, contact.normal.dot(apart));
+  if (!(budget > 0) && m_friction[index].isZero()) return std::max<Real>(0, shortfall);
   // The relative tangential displacement of the two sides over the substep.
   Vec3 slip = Vec3::Zero();
   for (int k = 0; k < 4; ++k) {
@@ -250,10 +385,11 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
   }
   slip -= slip.dot(contact.normal) * contact.normal;
   const Vec3 correction =
-      frictionCorrection(slip, m_friction[index], m_pushed[index], contact.friction);
+      frictionCorrection(slip, m_friction[index], budget, contact.friction);
+  const Real slipped = (correction - m_friction[index]).norm();
   move(correction - m_friction[index]);
   m_friction[index] = correction;
-  return std::max<Real>(0, shortfall);
+  return std::max({Real(0), shortfall, slipped});
 }
 
 Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,
@@ -278,8 +414,7 @@ Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,
       if (!contact.resting && contact.friction > 0) {
         // Met the body within the substep: friction on the velocity, bounded by the normal
         // velocity change (the solve's, the projection's and this one's).
-        kept = coulombFriction(tangential, contact.solveImpulse + m_pushed[c] / h + removed,
-                               contact.friction);
+        kept = coulombFriction(tangential, contact.solveImpulse + removed, contact.friction);
       }
       space.v[i] = on.velocity + std::max<Real>(0, normalSpeed) * on.normal + kept;
     } else if (contact.kind == ContactKind::FaceCollider) {

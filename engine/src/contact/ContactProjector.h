@@ -6,7 +6,12 @@
 // whose corrections are the same projection; Müller et al. 2020, "Detailed rigid body simulation
 // with extended position based dynamics", for friction at the position level):
 //  - edge e = (a, b): |x_b − x_a| ≤ (1 + limit) L, corrected along the edge in inverse proportion
-//    to mass (momentum kept, only pins take force);
+//    to mass (momentum kept, only pins take force); in the first sweep, where neither end touches
+//    anything, only the end farther from the pins moves ("follow the leader",
+//    ContactSpace::anchorDistance), which brings a long or heavily loaded hanging chain within its
+//    limit in one pass, where shared corrections would diffuse edge by edge;
+//    an end resting on a collider is moved only across the surface's normal, so the edges slide
+//    it on the body instead of pulling it in for the contact to push out again;
 //  - vertex–collider: the signed distance to the body (posed at the substep end) ≥ thickness,
 //    re-evaluated at the vertex's current position, the vertex followed from where it was last
 //    outside (a vertex an edge pulls across a thin body goes back to its own side);
@@ -20,13 +25,15 @@
 // limit by more than the tolerance and no contact is violated by more than its tolerance.
 //
 // Friction. A contact's friction may remove at most μ D of the tangential displacement of its two
-// sides over the substep, D being its normal displacement: the projection's push, plus h times
-// the solve's contact impulse for a collider contact (the solve carries a resting cloth's weight
-// and the projection then pushes nothing). A contact that rests at the substep start takes it on
-// its whole tangential displacement relative to the body, so that it sticks without creeping h² a
-// a substep; one that met the body within the substep takes it on its velocity instead (its end is
-// where its path slid on from the hit, not x₀ + h v). Each iteration recomputes the slip without
-// friction and sets the friction correction afresh, so the bound holds for the total.
+// sides over the substep, D being its normal displacement: how far the projection has moved its
+// sides apart along its normal, plus h times the solve's contact impulse for a collider contact
+// (the solve carries a resting cloth's weight and the projection then pushes nothing). A contact
+// that rests at the substep start takes it on its whole tangential displacement relative to the
+// body, so that it sticks without creeping h² a a substep; one that met the body within the
+// substep takes it on its velocity instead (its end is where its path slid on from the hit, not
+// x₀ + h v). Friction acts in the first sweep only: it holds what the solve moved, and the sweeps
+// after it enforce the strain limit and the separations, which friction may not resist (a cloth
+// pulled over a body at its limit slides on it).
 //
 // After the iteration: collider contacts and pairs keep no relative normal velocity into each
 // other (inelastic), and the face points left resting on a core are returned as supports, which
@@ -55,7 +62,7 @@ struct ProjectionSettings {
   /// Fraction of a contact's thickness it may stay violated when the iteration stops.
   Real contactTolerance = 1e-2;
   /// Gauss–Seidel sweeps at most; the report says what was left.
-  int maxIterations = 128;
+  int maxIterations = 256;
 };
 
 /// What one projection did.
@@ -95,6 +102,12 @@ class ContactProjector {
   std::vector<Real> m_pushed;     // m, normal displacement the projection gave it
   Vec3Array m_friction;           // m, the friction correction in place
   Vec3Array m_lastOutside;        // vertex contacts: where the vertex last was outside
+  bool m_frictionOn = true;       // friction acts in this sweep
+  bool m_followTheLeader = true;  // edges move only their end farther from the pins
+  std::vector<char> m_visited;
+  std::vector<char> m_touching;   // per vertex: in a contact of the set
+  Vec3Array m_surfaceNormal;      // per vertex: the collider surface it rests on, zero if none    // vertex contacts: path tested from the start already
+  Vec3Array m_solved;             // the positions the projection started from (the solve's)
 };
 
 }  // namespace weft

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <queue>
 #include <unordered_map>
 
 namespace weft {
@@ -23,6 +24,11 @@ void ContactSpace::build(std::span<Cloth* const> cloths) {
   edges.clear();
   restLengths.clear();
   longest.clear();
+  tetherAnchor.clear();
+  tetherLength.clear();
+  anchorDistance.clear();
+  edgeOrder.clear();
+  m_faceContacts.clear();
   for (std::size_t c = 0; c < m_cloths.size(); ++c) {
     const Cloth& cloth = *m_cloths[c];
     const ClothModel& model = cloth.model();
@@ -31,6 +37,7 @@ void ContactSpace::build(std::span<Cloth* const> cloths) {
     m_firstVertex.push_back(offset);
     owners.push_back(ContactOwner{settings.material.thickness, settings.material.friction,
                                   settings.selfCollision, settings.collideWithOtherCloths});
+    m_faceContacts.push_back(settings.faceContacts);
     x.insert(x.end(), cloth.positions().begin(), cloth.positions().end());
     v.insert(v.end(), cloth.velocities().begin(), cloth.velocities().end());
     inverseMass.insert(inverseMass.end(), cloth.inverseMasses().begin(),
@@ -60,7 +67,15 @@ void ContactSpace::build(std::span<Cloth* const> cloths) {
       triangles.push_back(corners);
       triangleEdges.push_back(sides);
     }
+    buildTethers(cloth, offset, factor);
   }
+  edgeOrder.resize(edges.size());
+  for (Index e = 0; e < Index(edges.size()); ++e) edgeOrder[e] = e;
+  const auto nearer = [&](Index e) {
+    return std::min(anchorDistance[edges[e][0]], anchorDistance[edges[e][1]]);
+  };
+  std::stable_sort(edgeOrder.begin(), edgeOrder.end(),
+                   [&](Index a, Index b) { return nearer(a) < nearer(b); });
   startX = x;
   startV = v;
 }
@@ -72,6 +87,51 @@ void ContactSpace::setMovable(std::size_t cloth, bool movable) {
     std::copy(own.begin(), own.end(), first);
   } else {
     std::fill(first, first + own.size(), Real(0));
+  }
+}
+
+void ContactSpace::buildTethers(const Cloth& cloth, Index offset, Real factor) {
+  const Index n = cloth.vertexCount();
+  tetherAnchor.resize(offset + n, kInvalidIndex);
+  tetherLength.resize(offset + n, std::numeric_limits<Real>::infinity());
+  anchorDistance.resize(offset + n, std::numeric_limits<Real>::infinity());
+  const std::vector<Index>& pins = cloth.settings().pinnedVertices;
+  if (pins.empty() || !std::isfinite(factor)) return;
+  // Dijkstra from every pin at once over the mesh edges at their rest lengths: the shortest path
+  // is at least the geodesic, so the tether is never tighter than the edges allow.
+  std::vector<std::vector<std::pair<Index, Real>>> neighbours(n);
+  for (const Edge& edge : cloth.model().edges()) {
+    neighbours[edge.vertices[0]].push_back({edge.vertices[1], edge.restLength});
+    neighbours[edge.vertices[1]].push_back({edge.vertices[0], edge.restLength});
+  }
+  std::vector<Real> distance(n, std::numeric_limits<Real>::infinity());
+  std::vector<Index> anchor(n, kInvalidIndex);
+  using Item = std::pair<Real, Index>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  for (Index pin : pins) {
+    distance[pin] = 0;
+    anchor[pin] = pin;
+    queue.push({0, pin});
+  }
+  while (!queue.empty()) {
+    const auto [d, vertex] = queue.top();
+    queue.pop();
+    if (d > distance[vertex]) continue;
+    for (const auto& [next, length] : neighbours[vertex]) {
+      // Ties go to the lower anchor, so the tethers do not depend on the queue's order.
+      const Real through = d + length;
+      if (through < distance[next] || (through == distance[next] && anchor[vertex] < anchor[next])) {
+        distance[next] = through;
+        anchor[next] = anchor[vertex];
+        queue.push({through, next});
+      }
+    }
+  }
+  for (Index i = 0; i < n; ++i) anchorDistance[offset + i] = distance[i];
+  for (Index i = 0; i < n; ++i) {
+    if (cloth.pinnedMask()[i] || anchor[i] == kInvalidIndex) continue;
+    tetherAnchor[offset + i] = offset + anchor[i];
+    tetherLength[offset + i] = factor * distance[i];
   }
 }
 

@@ -66,6 +66,27 @@ class ContactSpace {
   std::vector<Real> restLengths;                    ///< m, per edge
   /// m, per edge: the longest the strain limit allows ((1 + limit) · rest; infinity: no limit).
   std::vector<Real> longest;
+  /// Tethers (the strain limit's long-range part): each free vertex of a cloth with pins and a
+  /// strain limit may be at most `tetherLength` from its anchor, the pin nearest along the mesh
+  /// at rest, (1 + limit) times that path. Every edge at its limit allows exactly that, so a
+  /// tether never conflicts with the edges; it brings a long or heavily loaded chain within its
+  /// limit in one sweep where edge corrections alone travel one edge per sweep and a heavy vertex
+  /// moves by m_light / m_heavy of its excess per sweep. kInvalidIndex: none.
+  std::vector<Index> tetherAnchor;
+  std::vector<Real> tetherLength;
+  /// m, per vertex: the rest path length to the nearest pin of its cloth (infinity: none). An
+  /// edge over its limit moves only its end farther from the pins (the nearer end is held by
+  /// the pins through the cloth: "follow the leader", Müller et al. 2012), so a hanging chain is
+  /// brought within its limit in one sweep instead of diffusing the correction edge by edge.
+  std::vector<Real> anchorDistance;
+  /// The edges in the order the projector sweeps them: by the anchor distance of their nearer
+  /// end, then by index (nearest the pins first).
+  std::vector<Index> edgeOrder;
+
+  /// Marks whether a cloth's faces are kept out of colliders (ClothSettings::faceContacts).
+  bool faceContacts(Index vertex) const {
+    return m_faceContacts.empty() || m_faceContacts[owner[vertex]] != 0;
+  }
 
   /// Thickness (m) and friction of a pair of vertices' owners: the larger thickness and the
   /// geometric mean of the frictions (one owner: its own values).
@@ -75,8 +96,11 @@ class ContactSpace {
   bool pairsAllowed(Index a, Index b) const;
 
  private:
+  void buildTethers(const Cloth& cloth, Index offset, Real factor);
+
   std::vector<Cloth*> m_cloths;
   std::vector<Index> m_firstVertex;
+  std::vector<char> m_faceContacts;  // per cloth
 };
 
 }  // namespace weft

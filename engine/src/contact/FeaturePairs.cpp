@@ -25,8 +25,21 @@ void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
   std::vector<Index> indices;
   indices.reserve(3 * space.triangles.size());
   for (const auto& triangle : space.triangles) indices.insert(indices.end(), triangle.begin(), triangle.end());
+  // The tree groups triangles by their rest shape, which keeps leaves coherent as the cloth
+  // deforms; each cloth's rest shape is laid beside the others' so that no leaf mixes cloths.
+  Vec3Array layout(space.rest.size());
+  Real shift = 0;
+  std::size_t begin = 0;
+  while (begin < space.rest.size()) {
+    std::size_t end = begin;
+    Aabb box = Aabb::empty();
+    while (end < space.rest.size() && space.owner[end] == space.owner[begin]) box.expand(space.rest[end++]);
+    for (std::size_t i = begin; i < end; ++i) layout[i] = space.rest[i] + Vec3(shift - box.min.x(), 0, 0);
+    shift += (box.max.x() - box.min.x()) + 1;
+    begin = end;
+  }
   const Real margin = m_bvh.refitMargin();
-  m_bvh = Bvh::build(indices, space.x).value();
+  m_bvh = Bvh::build(indices, layout).value();
   m_bvh.setRefitMargin(margin);
 
   const Index vertexCount = space.vertexCount();

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <cstdio>
+#include <cstdlib>
 
 namespace weft {
 namespace {
@@ -50,10 +52,29 @@ void ImpactResolver::build(const ContactSpace& space, TaskSystem* tasks) {
   m_testedEnd.resize(n);
 }
 
-Index ImpactResolver::keepOutOfColliders(ContactSpace& space,
+Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& set,
                                          std::span<const ColliderFrame> colliders, Real h) {
   m_near.clear();
   if (colliders.empty()) return 0;
+  // The faces, swept until no point moves more than round-off (neighbouring faces share
+  // corners), a few times at most.
+  constexpr int kFaceSweeps = 4;
+  constexpr Real kSettledDepth = 1e-9;
+  for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
+    Real deepest = 0;
+    for (std::size_t c = 0; c < set.firstPair; ++c) {
+      const Contact& contact = set.contacts[c];
+      if (contact.kind != ContactKind::FaceCollider) continue;
+      Vec3 normal;
+      deepest = std::max(deepest, pushFaceOut(set.cores[contact.core], contact.normal,
+                                              colliders[contact.collider].end.pose,
+                                              {contact.vertices[0], contact.vertices[1],
+                                               contact.vertices[2]},
+                                              space.inverseMass, space.x, space.v, 0, normal));
+    }
+    if (std::getenv("WEFT_DEBUG")) std::fprintf(stderr, "  face sweep %d deepest %.3e\n", sweep, deepest);
+    if (!(deepest > kSettledDepth)) break;
+  }
   Real thickness = 0;
   for (const ContactOwner& owner : space.owners) thickness = std::max(thickness, owner.thickness);
   Aabb path = Aabb::empty();
@@ -69,7 +90,9 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space,
         if (space.inverseMass[i] != 0) box.expand(colliders[k].carry(space.startX[i]));
       }
     }
-    if (mayTouch(colliders[k].shape, box, thickness * (1 + 1e-6) + 1e-9)) m_near.push_back(k);
+    if (!m_skip || mayTouch(colliders[k].shape, box, thickness * (1 + 1e-6) + 1e-9)) {
+      m_near.push_back(k);
+    }
   }
   if (m_near.empty()) return 0;
   WEFT_PROFILE_ZONE("collider impacts");
@@ -82,7 +105,6 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space,
       const ColliderFrame& collider = colliders[k];
       const Vec3 outside = keepOutside(collider, space.startX[i], space.x[i], thickness);
       if (outside == space.x[i]) continue;
-      space.v[i] += (outside - space.x[i]) / h;
       space.x[i] = outside;
       // Inelastic: no relative velocity into the surface.
       const ShapeContact on = queryPoint(collider.shape, outside);
@@ -91,6 +113,17 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space,
       moved = true;
     }
     corrected += moved;
+  }
+  if (std::getenv("WEFT_DEBUG")) {
+    Real deepest = 0;
+    for (std::size_t c = 0; c < set.firstPair; ++c) {
+      const Contact& contact = set.contacts[c];
+      if (contact.kind != ContactKind::FaceCollider) continue;
+      Vec3Array copy = space.x, vcopy = space.v;
+      Vec3 normal;
+      deepest = std::max(deepest, pushFaceOut(set.cores[contact.core], contact.normal, colliders[contact.collider].end.pose, {contact.vertices[0], contact.vertices[1], contact.vertices[2]}, space.inverseMass, copy, vcopy, 1 / h, normal));
+    }
+    std::fprintf(stderr, "  after vertex pass: face depth %.3e, corrected %u\n", deepest, corrected);
   }
   return corrected;
 }
@@ -327,12 +360,12 @@ void ImpactResolver::rigidifyZones(const ContactSpace& space) {
   }
 }
 
-ImpactReport ImpactResolver::resolve(ContactSpace& space, std::span<const ColliderFrame> colliders,
-                                     Real h, bool pairs) {
+ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
+                                     std::span<const ColliderFrame> colliders, Real h, bool pairs) {
   WEFT_PROFILE_ZONE("impacts");
   ImpactReport report;
   m_colliders = colliders;
-  report.colliderCorrections = keepOutOfColliders(space, colliders, h);
+  report.colliderCorrections = keepOutOfColliders(space, set, colliders, h);
   if (!pairs) return report;
   const Index n = space.vertexCount();
   const Vec3Array& start = space.startX;

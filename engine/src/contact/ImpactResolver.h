@@ -3,9 +3,11 @@
 //
 // It runs on the substep's start x₀ and the end x₁ the projection left, through the average
 // velocity v̄ = (x₁ − x₀)/h, and changes only what must change:
-//  1. Colliders: every vertex's path relative to each body is traced; one that passed through a
-//     body or ends within its thickness is put back outside and keeps no velocity into it (a body
-//     too fast or too thin for the detection's candidates).
+//  1. Colliders: the faces of the substep's face contacts are put back at their reach from the
+//     cores (converged, where the projection stopped at its tolerance), then every vertex's path
+//     relative to each body is traced; one that passed through a body or ends within its
+//     thickness is put back outside and keeps no velocity into it (a body too fast or too thin
+//     for the detection's candidates). The vertices keep the last word over the faces.
 //  2. Swept tests: the motion x₀ → x₀ + h v̄ of every vertex–triangle and edge–edge pair of the
 //     broad phase is tested for the first time of coplanarity; each hit gets an impulse that
 //     leaves the pair separating. Repeated a bounded number of passes, each testing again only
@@ -25,6 +27,7 @@
 #pragma once
 
 #include "contact/ColliderFrame.h"
+#include "contact/ContactSet.h"
 #include "contact/ContactSpace.h"
 #include "contact/FeaturePairs.h"
 
@@ -50,12 +53,14 @@ class ImpactResolver {
   /// Builds the broad-phase tables (when the space's cloths change).
   void build(const ContactSpace& space, TaskSystem* tasks);
   void setRefitMargin(Real margin) { m_features.setRefitMargin(margin); }
+  /// `skip`: WorldSettings::skipUnneededStages; off, every collider is traced, near or not.
+  void setSkipping(bool skip) { m_skip = skip; }
 
   /// Corrects space.x and space.v (from space.startX over h) as the file comment says. `pairs`:
   /// run the swept tests between cloth features (false when no cloth can touch itself or
   /// another this substep).
-  ImpactReport resolve(ContactSpace& space, std::span<const ColliderFrame> colliders, Real h,
-                       bool pairs);
+  ImpactReport resolve(ContactSpace& space, const ContactSet& set,
+                       std::span<const ColliderFrame> colliders, Real h, bool pairs);
 
   Bvh::RefitCounts takeRefitCounts() { return m_features.takeRefitCounts(); }
 
@@ -71,7 +76,8 @@ class ImpactResolver {
     Index pair;
     Impact impact;
   };
-  Index keepOutOfColliders(ContactSpace& space, std::span<const ColliderFrame> colliders, Real h);
+  Index keepOutOfColliders(ContactSpace& space, const ContactSet& set,
+                           std::span<const ColliderFrame> colliders, Real h);
   bool findImpacts(const ContactSpace& space, Real h);
   void applyImpulse(const Impact& impact, Real targetNormalSpeed, const ContactSpace& space);
   void rigidifyZones(const ContactSpace& space);
@@ -79,6 +85,7 @@ class ImpactResolver {
   void clampToColliders(const ContactSpace& space, Real h);
 
   TaskSystem* m_tasks = nullptr;
+  bool m_skip = true;
   FeaturePairs m_features;
   std::span<const ColliderFrame> m_colliders;
   std::vector<Index> m_near;                 // colliders near the cloth this substep
