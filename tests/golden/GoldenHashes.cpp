@@ -13,6 +13,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <vector>
 
 #if !defined(WEFT_GOLDEN_FILE) || !defined(WEFT_GOLDEN_REFERENCE_BUILD)
 #error "tests/CMakeLists.txt defines WEFT_GOLDEN_FILE and WEFT_GOLDEN_REFERENCE_BUILD (0 or 1)"
