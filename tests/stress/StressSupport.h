@@ -22,6 +22,8 @@
 // scene's comment), and nothing is tuned to pass.
 #pragma once
 
+#include "golden/GoldenHashes.h"
+
 #include <weft/collision/SelfIntersectionCounter.h>
 #include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
@@ -134,8 +136,11 @@ class StressMonitor {
   Index maxIntersections() const { return m_maxIntersections; }
   Real capFraction() const { return m_frames ? Real(m_capHits) / m_frames : 0; }
 
-  /// Prints and records the figures under `name`.
+  /// Prints and records the figures under `name`, and checks the world's state against its
+  /// golden hash "stress/<name>" (tests/golden/GoldenHashes.h): every scene reports, so every
+  /// scene and every draw of a parameterised one is pinned.
   void report(const std::string& name) const {
+    test::expectGoldenHash("stress/" + name, m_world.stateHash());
     std::printf("[stress] %-40s frames %5d  max strain %.4f (peak %.4f)  intersections %u "
                 "(checked %d times)  cap hits %d (%.2f %%)  retried %d  rolled back %d  edges the "
                 "strain limiter left over %llu\n",
