@@ -89,9 +89,9 @@ enum class SpringKind : std::uint8_t {
 
 /// One spring of the mass-spring network.
 struct Spring {
-  std::array<Index, 2> vertices{};
+  std::array<Index, 2> vertices{};  ///< the two vertices it joins
   Real restLength = 0;  ///< m
-  SpringKind kind = SpringKind::Structural;
+  SpringKind kind = SpringKind::Structural;  ///< which family (and so which stiffness) it has
 };
 
 /// An undirected mesh edge and the triangles on either side.
@@ -147,13 +147,18 @@ class ClothModel {
   /// readObj() followed by fromMesh().
   static Result<ClothModel> loadObj(const std::string& path, const MeshSettings& settings = {});
 
+  /// Number of vertices.
   Index vertexCount() const { return static_cast<Index>(m_restPositions.size()); }
+  /// Number of triangles.
   Index triangleCount() const { return static_cast<Index>(m_triangles.size()); }
 
+  /// m, the rest shape, one position per vertex.
   const Vec3Array& restPositions() const { return m_restPositions; }
   /// Three vertex indices per triangle, in the mesh's winding (for rendering and collision).
   const std::vector<Index>& indices() const { return m_indices; }
+  /// Per triangle: vertices and rest quantities of the Baraff–Witkin stretch and shear terms.
   const std::vector<TriangleRest>& triangles() const { return m_triangles; }
+  /// Interior edges with their two triangles: the dihedral bending hinges.
   const std::vector<Hinge>& hinges() const { return m_hinges; }
   /// Isometric bending terms, three per vertex (vertices next to non-manifold edges have none),
   /// in vertex order.
@@ -162,7 +167,9 @@ class ClothModel {
   const std::vector<StencilWeight>& bendingWeights() const { return m_bendingWeights; }
   /// Triangles whose normals the curved-rest stencils need (BendingStencil::firstTriangle).
   const std::vector<Index>& bendingTriangles() const { return m_bendingTriangles; }
+  /// Every undirected mesh edge (strain, strain limiting, collision).
   const std::vector<Edge>& edges() const { return m_edges; }
+  /// The mass-spring network (ForceModel::MassSpring).
   const std::vector<Spring>& springs() const { return m_springs; }
   /// m², a third of the rest area of every triangle around each vertex (lumped mass = ρ_A · area).
   const std::vector<Real>& vertexAreas() const { return m_vertexAreas; }

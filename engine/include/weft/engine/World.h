@@ -36,7 +36,9 @@ class ClothClothCollision;  // internal: contact between cloths
 struct ClothId {
   std::uint32_t index = 0;       ///< slot + 1 (0 = null)
   std::uint32_t generation = 0;  ///< must match the slot's generation
+  /// True for the zero-initialised (null) handle.
   bool isNull() const { return index == 0; }
+  /// Same slot and generation.
   friend bool operator==(const ClothId&, const ClothId&) = default;
 };
 
@@ -44,7 +46,9 @@ struct ClothId {
 struct ColliderId {
   std::uint32_t index = 0;       ///< slot + 1 (0 = null)
   std::uint32_t generation = 0;  ///< must match the slot's generation
+  /// True for the zero-initialised (null) handle.
   bool isNull() const { return index == 0; }
+  /// Same slot and generation.
   friend bool operator==(const ColliderId&, const ColliderId&) = default;
 };
 
@@ -86,21 +90,13 @@ struct ClothSettings {
   /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
-  /// Keeps the cloth's faces, not only its vertices, out of every collider but a plane: a
-  /// body thinner than the triangles (a 2 cm rod or plank under 5 cm edges) otherwise passes
-  /// between the vertices, and the cloth falls through it or hangs on it by a stretched edge.
-  /// Costs a box test per triangle per nearby collider per collision pass (and a tree query for
-  /// a mesh), and closest-point tests near the body; turn off only for meshes much finer than every collider.
+  /// Keeps the cloth's faces, not only its vertices, out of every collider but a plane, so a rod
+  /// or plank thinner than the triangles cannot pass between the vertices. Costs a box test per
+  /// triangle per nearby collider and pass; turn off only for meshes much finer than every collider.
   bool faceContacts = true;
-  /// With the strain limiter on: in a substep in which the cloth touches a collider and itself,
-  /// the limiter's rounds in contact satisfy the edge limits, every self-contact of the substep and
-  /// the vertices' and faces' collider contacts together (ColliderProjection) instead of one pass
-  /// after the other. Keeps cloth jammed between bodies within the strain limit (three sheets
-  /// pushed through a ring of capsules: 0.101 instead of 0.79 … 4.7); costs up to 4 times the
-  /// limiter's iterations and rounds in such substeps (the curtain: p50 about 2 %).
-  /// Off, and in substeps without self-contacts: the sequential rounds, collider contacts held
-  /// along their normals (which keep a cloth resting on a body still; the projection takes no
-  /// friction).
+  /// With the strain limiter on, in substeps where the cloth touches a collider and itself: the
+  /// edge limits, self-contacts and collider contacts are satisfied together, which keeps cloth
+  /// squeezed between bodies within its limit (up to 4× the limiter's work there). Off: in turn.
   bool jointContactProjection = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
   /// Keeps the cloth from passing through other cloths of the world that have this switch on
@@ -117,9 +113,13 @@ class WorldState {
  public:
   WorldState();
   ~WorldState();
+  /// A deep copy (a moved-from state copies as empty).
   WorldState(const WorldState&);
+  /// A deep copy (a moved-from state copies as empty).
   WorldState& operator=(const WorldState&);
+  /// Moves the snapshot; the moved-from state is empty and refused by restoreState().
   WorldState(WorldState&&) noexcept;
+  /// Moves the snapshot; the moved-from state is empty and refused by restoreState().
   WorldState& operator=(WorldState&&) noexcept;
 
  private:
@@ -138,19 +138,21 @@ struct WorldSettings {
   /// The caller's own task system (and so its oneTBB arena), which must outlive the world. Null:
   /// the world makes one with threadCount threads. Nothing else spawns threads.
   TaskSystem* taskSystem = nullptr;
-  /// Skip the stages a scene does not need: the narrow phase against colliders whose box is not
-  /// near the cloth, self-collision for a cloth that cannot fold onto itself, bending and damping
-  /// terms whose coefficients are zero. The skips are exact (same bits) except the self-collision
-  /// cull, which is conservative by a stated margin (see FoldCulling). Off: every stage runs
-  /// every substep, for checking that the skips change nothing. Sleeping is ClothSettings::sleep.
+  /// Skip the stages a scene does not need (far colliders, self-collision of cloth that cannot
+  /// touch itself, zero bending and damping terms, refits of still parts): the same bits, except
+  /// the conservative self-collision cull. Off: every stage runs, to check that. docs/tuning.md.
   bool skipUnneededStages = true;
 };
 
+/// Owns cloths and colliders and steps them (see the note at the top of this file).
 class World {
  public:
+  /// An empty world; it makes its own task system unless settings.taskSystem is given.
   explicit World(const WorldSettings& settings = {});
   ~World();
+  /// Move-only: handles stay valid in the moved-to world.
   World(World&&) noexcept;
+  /// Move-only: handles stay valid in the moved-to world.
   World& operator=(World&&) noexcept;
 
   /// Adds a cloth. Fails with a message on invalid settings (non-positive density, negative

@@ -135,9 +135,9 @@ struct SceneDescription {
   std::vector<WindKeyframe> windKeyframes; ///< empty: the wind stays `wind`
   Index frames = 600;             ///< frames of a full run
   Real frameDt = 1.0 / 60.0;      ///< s per frame
-  SceneCamera camera;
-  std::vector<ClothDescription> cloths;
-  std::vector<ColliderDescription> colliders;
+  SceneCamera camera;             ///< for `weft run --render`
+  std::vector<ClothDescription> cloths;        ///< at least one, in file order
+  std::vector<ColliderDescription> colliders;  ///< in file order
 };
 
 /// One problem in a scene file.
@@ -156,8 +156,8 @@ struct SceneLoadOptions {
 
 /// The outcome of parsing: a description when `issues` is empty.
 struct SceneParseOutcome {
-  std::optional<SceneDescription> scene;
-  std::vector<SceneIssue> issues;
+  std::optional<SceneDescription> scene;  ///< the validated scene; none when there are issues
+  std::vector<SceneIssue> issues;         ///< every problem found (up to maxIssues)
 };
 
 /// Parses and validates scene JSON. Never throws.
