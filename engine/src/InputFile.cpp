@@ -121,8 +121,9 @@ Result<std::string> readInputFile(const std::string& path, std::uint64_t maxByte
     return Error{"cannot read " + name + ": it is " + fileKind(status.st_mode) +
                  ", not a regular file; give the path of a file"};
   }
-  const std::string limit = "the limit of " + std::to_string(maxBytes) + " bytes (" +
-                            formatBytes(maxBytes) + ") for " + std::string(kind) + "s";
+  const std::string limit = "the limit of " + std::to_string(maxBytes) + " bytes" +
+                            (maxBytes >= 1000 ? " (" + formatBytes(maxBytes) + ")" : std::string()) +
+                            " for " + std::string(kind) + "s";
   if (std::uint64_t(status.st_size) > maxBytes) {
     return Error{name + " is " + std::to_string(status.st_size) + " bytes, more than " + limit +
                  "; give a smaller file"};
@@ -150,7 +151,7 @@ Result<std::string> readInputFile(const std::string& path, std::uint64_t maxByte
     text.append(buffer, std::size_t(got));
     if (text.size() > maxBytes) {
       return Error{name + " is larger than " + limit +
-                   " (it kept growing while read); give a smaller file"};
+                   " (found while reading it: its size was not known, or it grew); give a smaller file"};
     }
   }
   return text;

@@ -622,7 +622,7 @@ TEST(BadInputFiles, FilesAboveTheLimitAreRefusedUnread) {
   // A file whose size the file system does not tell (/proc) is cut off one byte past the limit.
   Result<std::string> status = readInputFile("/proc/self/status", 16, "status file");
   ASSERT_FALSE(status.ok());
-  EXPECT_THAT(status.error().message, HasSubstr("is larger than the limit of 16 bytes (16 bytes) for status files"));
+  EXPECT_THAT(status.error().message, HasSubstr("is larger than the limit of 16 bytes for status files (found while reading it"));
   ASSERT_TRUE(readInputFile("/proc/self/status", 1 << 20, "status file").ok());
 }
 

@@ -13,8 +13,9 @@ namespace weft {
 
 /// The whole of a regular file as bytes, or an error naming the file (as "<kind> '<path>'") and
 /// the fix: a directory, device, FIFO or socket is refused without being read, and so is a file
-/// of more than maxBytes or more than the available memory (a file that grows while it is read
-/// is cut off at maxBytes + 1 and refused too). Never blocks on a FIFO, never throws.
+/// of more than maxBytes or more than the available memory (a file whose size the file system
+/// does not tell, as under /proc, or that grows while read is cut off at maxBytes + 1 and
+/// refused). Never blocks on a FIFO, never throws.
 Result<std::string> readInputFile(const std::string& path, std::uint64_t maxBytes,
                                   std::string_view kind);
 
