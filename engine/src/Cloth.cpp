@@ -27,7 +27,7 @@ constexpr Real kBvhRefitMotionPerThickness = 0.02;
 // A vertex faster than this (m/s) means the integration diverged: no cloth motion comes near
 // it (a 250 m/s projectile drags cloth at 250 m/s), while a blown-up explicit step passes it
 // within a few substeps.
-constexpr Real kDivergedSpeed = 1e4;
+constexpr Real kDivergedSpeed = kMaxSpeed;
 // Retries of a failed frame, each with twice the substeps: up to 8 times the planned number.
 constexpr int kMaxRetries = 3;
 // A sleeping cloth watches colliders within this distance (m) beyond its contact thickness: far

@@ -63,7 +63,9 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   worldSettings.threadCount = settings.threadCount;
   worldSettings.taskSystem = settings.taskSystem;
   worldSettings.skipUnneededStages = settings.skipUnneededStages;
-  scene.m_world = std::make_unique<World>(worldSettings);
+  Result<World> world = World::create(worldSettings);
+  if (!world.ok()) return Error{"curtain settings: " + world.error().message};
+  scene.m_world = std::make_unique<World>(std::move(world).value());
   scene.m_pinScript = settings.pinScript;
 
   ClothSettings cloth;

@@ -156,6 +156,12 @@ int runScene(const RunOptions& options, std::ostream& out) {
       << "  frames     " << frames << " of " << scenario.frameDt * 1000 << " ms ("
       << frames * scenario.frameDt << " s simulated), threads " << scene.world().threadCount() << "\n";
   if (!options.quiet && !scenario.description.empty()) out << "  about      " << scenario.description << "\n";
+  for (const ClothDescription& cloth : scenario.cloths) {
+    const MeshImport& import = cloth.model->meshImport();
+    if (import.weldedVertices == 0 && import.flippedTriangles == 0) continue;
+    out << "  mesh       '" << cloth.name << "': welded " << import.weldedVertices
+        << " coincident vertices, flipped " << import.flippedTriangles << " triangles\n";
+  }
 
 #if WEFT_HAVE_RENDER
   std::unique_ptr<SceneDrawing> drawing;

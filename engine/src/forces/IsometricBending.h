@@ -73,10 +73,12 @@ struct BendingStencils {
 
 /// Builds the stencils of a mesh from its rest positions and triangles. `edges` as in ClothModel,
 /// where triangles[1] == kInvalidIndex marks a boundary edge and kInvalidIndex − 1 an edge shared
-/// by more than two triangles.
+/// by more than two triangles. Vertices on such edges, and those in `skipped` (bowties: fans
+/// that meet at a point transmit no bending), get no stencil.
 BendingStencils buildBendingStencils(const Vec3Array& restPositions,
                                      const std::vector<Index>& indices,
-                                     const std::vector<Edge>& edges);
+                                     const std::vector<Edge>& edges,
+                                     const std::vector<Index>& skipped = {});
 
 /// S(x) = Σ_j w_j x_j over the stencil's weights (the centre's included), in m.
 Vec3 stencilVector(const BendingStencil& stencil, std::span<const StencilWeight> weights,

@@ -50,7 +50,7 @@ std::string describe(StepStatus status);
 enum class HealthFailure : std::uint8_t {
   None = 0,
   NonFinite,   ///< a position or velocity became NaN or infinite
-  Speed,       ///< a vertex moved faster than 10⁴ m/s
+  Speed,       ///< a vertex moved faster than kMaxSpeed (10⁴ m/s, InputLimits.h)
   Strain,      ///< an edge grew to more than 100× its rest length, longer than at the frame start
   EnergyJump,  ///< kinetic energy rose 100× above what the frame's own sources could supply
 };

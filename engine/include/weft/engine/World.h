@@ -132,8 +132,9 @@ class WorldState {
 struct WorldSettings {
   Vec3 gravity{0.0, -9.81, 0.0};  ///< m/s²
   Vec3 wind{0.0, 0.0, 0.0};       ///< m/s, air velocity felt through ClothMaterial::airDrag
-  /// Threads the world's loops run on, the caller's included: 0 = the machine's cores, 1 = serial.
-  /// Results are bitwise the same for every count. Ignored when taskSystem is given.
+  /// Threads the world's loops run on, the caller's included: 0 = the machine's cores, 1 = serial,
+  /// at most TaskSystemSettings::kMaxThreadCount. The same bits for every count. Ignored when
+  /// taskSystem is given.
   int threadCount = 0;
   /// The caller's own task system (and so its oneTBB arena), which must outlive the world. Null:
   /// the world makes one with threadCount threads. Nothing else spawns threads.
@@ -147,7 +148,11 @@ struct WorldSettings {
 /// Owns cloths and colliders and steps them (see the note at the top of this file).
 class World {
  public:
-  /// An empty world; it makes its own task system unless settings.taskSystem is given.
+  /// A world, or an error naming the field of `settings` that is wrong (gravity not finite or
+  /// beyond kMaxGravity, wind beyond kMaxSpeed, threadCount out of range) and the fix.
+  static Result<World> create(const WorldSettings& settings = {});
+  /// A world without the check; it makes its own task system unless settings.taskSystem is
+  /// given. Invalid settings make every createCloth() fail with the error create() would give.
   explicit World(const WorldSettings& settings = {});
   ~World();
   /// Move-only: handles stay valid in the moved-to world.
@@ -156,8 +161,13 @@ class World {
   World& operator=(World&&) noexcept;
 
   /// Adds a cloth. Fails with a message on invalid settings (non-positive density, negative
-  /// stiffness, pins out of range, non-finite pose...), leaving the world unchanged.
+  /// stiffness, a value beyond kMaxMaterialValue, pins out of range, non-finite pose, a vertex
+  /// placed beyond kMaxCoordinate...) or when its estimated memory is not available, leaving the
+  /// world unchanged.
   Result<ClothId> createCloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings);
+  /// bytes, an upper bound on the heap a cloth of this size takes in a world through its first
+  /// frames (about 1.3 times the measured peak; the shared model not included).
+  static std::uint64_t estimatedClothBytes(std::uint64_t vertices, std::uint64_t triangles);
   /// Removes a cloth; its handle (and copies of it) become stale.
   Status destroyCloth(ClothId cloth);
 
@@ -165,16 +175,18 @@ class World {
   /// ClothSettings::pinnedVertices, same order). Pins move linearly across the frame; when every
   /// pin jumps farther than SolverSettings::pinTeleportDistance, or the pins turn rigidly by more
   /// than SolverSettings::pinTeleportAngle, the frame is a teleport and the cloth is carried with
-  /// them instead of dragged. On error nothing changes.
+  /// them instead of dragged. Targets must be finite and within kMaxCoordinate; on error nothing
+  /// changes.
   Status setPinTargets(ClothId cloth, std::span<const Vec3> targets);
   /// Adds a kinematic collider (plane, sphere, capsule, box or triangle mesh; see
   /// weft/collision). Its motion (pose and velocities) is the shape's own; it moves with those
-  /// velocities during each step until setColliderMotion() changes them.
+  /// velocities during each step until setColliderMotion() changes them. Its linear velocity
+  /// must be within kMaxSpeed.
   Result<ColliderId> addCollider(const Shape& shape, const ColliderSettings& settings = {});
   /// Removes a collider; its handle becomes stale.
   Status destroyCollider(ColliderId collider);
   /// Sets the collider's pose now and its linear (m/s) and angular (rad/s) velocity for the
-  /// following steps. Validated; on error nothing changes.
+  /// following steps. Validated (a linear velocity within kMaxSpeed); on error nothing changes.
   Status setColliderMotion(ColliderId collider, const RigidMotion& motion);
   /// The collider's shape, posed where it is now; valid until the next step or destroy.
   Result<const Shape*> collider(ColliderId collider) const;
@@ -194,21 +206,22 @@ class World {
 
   /// N, a force on each vertex of the cloth (one per vertex, in vertex order), applied every
   /// substep until changed; an empty span removes them. Pinned vertices ignore it. Game forces
-  /// such as a blast, a hand pulling or a scripted gust go here. Wakes the cloth. On error
-  /// nothing changes.
+  /// such as a blast, a hand pulling or a scripted gust go here. Wakes the cloth. Each within
+  /// kMaxMaterialValue N; on error nothing changes.
   Status setExternalForces(ClothId cloth, std::span<const Vec3> forces);
   /// m/s, the air velocity every cloth feels through ClothMaterial::airDrag from the next step
-  /// on (WorldSettings::wind at creation); wakes every cloth. Must be finite; on error nothing
-  /// changes.
+  /// on (WorldSettings::wind at creation); wakes every cloth. Must be finite and within
+  /// kMaxSpeed; on error nothing changes.
   Status setWind(const Vec3& wind);
   /// m/s, the current air velocity.
   const Vec3& wind() const { return m_settings.wind; }
 
   /// Replaces a cloth's positions (m) and velocities (m/s), e.g. to start from a draped shape or
   /// to teleport it. Pinned vertices jump with it and their targets are set to the new positions.
-  /// Sizes must match the vertex count and every value must be finite; on error nothing changes.
+  /// Sizes must match the vertex count, every value must be finite, positions within
+  /// kMaxCoordinate and velocities within kMaxSpeed; on error nothing changes.
   Status setState(ClothId cloth, std::span<const Vec3> positions, std::span<const Vec3> velocities);
-  /// Changes gravity (m/s²) for every cloth and wakes them all. Finite values only.
+  /// Changes gravity (m/s²) for every cloth and wakes them all. Finite, within kMaxGravity.
   Status setGravity(const Vec3& gravity);
   /// Wakes a sleeping cloth (no effect on an awake one).
   Status wake(ClothId cloth);
@@ -296,6 +309,7 @@ class World {
   void collideCloths(Real frameDt, StepStats& stats);
   std::unique_ptr<ClothClothCollision> m_clothContact;
   std::uint64_t m_identity = 0;  // unique per World, so a state saved elsewhere is refused
+  std::string m_settingsError;   // why the settings are invalid (then createCloth refuses)
 };
 
 }  // namespace weft

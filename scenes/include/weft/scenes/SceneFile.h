@@ -150,8 +150,11 @@ struct SceneIssue {
 struct SceneLoadOptions {
   /// Directory that relative OBJ paths are resolved against (loadSceneFile: the file's own).
   std::string baseDirectory = ".";
-  Index maxVerticesPerCloth = 4'000'000;  ///< grids and meshes above this are refused
-  Index maxIssues = 50;                   ///< stop collecting after this many problems
+  /// Grids and meshes above this are refused, and so is any cloth whose model and world state
+  /// (ClothModel::estimatedBuildBytes + World::estimatedClothBytes) exceed the available memory.
+  Index maxVerticesPerCloth = 4'000'000;
+  Index maxIssues = 50;                    ///< stop collecting after this many problems
+  std::uint64_t maxFileBytes = 64ull << 20;  ///< bytes; larger scene files are refused unread
 };
 
 /// The outcome of parsing: a description when `issues` is empty.
@@ -162,7 +165,8 @@ struct SceneParseOutcome {
 
 /// Parses and validates scene JSON. Never throws.
 SceneParseOutcome parseSceneText(std::string_view json, const SceneLoadOptions& options = {});
-/// Reads and parses a scene file; relative OBJ paths are resolved against its directory.
+/// Reads and parses a scene file (a regular file of at most options.maxFileBytes); relative OBJ
+/// paths are resolved against its directory.
 SceneParseOutcome parseSceneFile(const std::string& path, SceneLoadOptions options = {});
 
 /// parseSceneFile() as a Result: the error lists one "path: message" line per issue.
