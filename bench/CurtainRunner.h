@@ -1,8 +1,8 @@
-// The curtain runner: the frame loop of the main job (DESIGN.md §4, §8).
+// The curtain runner: the frame loop of the main job (docs/curtain-benchmark.md).
 //
 // It steps the curtain scene frame by frame, as a game would, timing each frame's simulation
 // (and rendering, when weft::render is built and --render is not off), and writes a report, a
-// JSON summary with the keys of DESIGN.md §8 and an optional per-frame CSV.
+// JSON summary, and optionally a per-frame CSV with a chart of it beside (gnuplot).
 #pragma once
 
 #include <weft/engine/SolverSettings.h>
@@ -29,7 +29,7 @@ struct CurtainRunOptions {
   bool sleep = true;               ///< let the curtain sleep when at rest
   std::string captureDirectory;    ///< where PNG frames go; empty = no capture
   std::string summaryJson;         ///< JSON summary path; empty = none
-  std::string frameCsv;            ///< per-frame CSV path; empty = none
+  std::string frameCsv;            ///< per-frame CSV path, with a PNG chart beside it; empty = none
   std::string trace;               ///< Chrome trace-event JSON path (Perfetto); empty = no profiling
   IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< time integrator
   bool progress = true;            ///< print a progress line every second of simulated time

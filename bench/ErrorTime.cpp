@@ -1,4 +1,4 @@
-// Error-vs-time sweep (DESIGN.md §6).
+// Error-vs-time sweep: accuracy against cost on the curtain (bench/results/error-time-curtain.md).
 //
 // Design note. Every run is the curtain scene with its pin script, stepped frame by frame exactly
 // as the curtain runner does, with one SolverSettings changed. Its error is measured against a
@@ -488,7 +488,7 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
   const Real length = model->characteristicLength();
   const Real energyScale = model->totalMass(material.arealDensity) * 9.81 * length;
 
-  out << "Weft error-vs-time sweep (DESIGN.md §6), curtain size x" << size << ": "
+  out << "Weft error-vs-time sweep, curtain size x" << size << ": "
       << model->vertexCount() << " vertices, characteristic length " << length << " m\n"
       << "  samples at";
   for (Real t : sampleTimes) out << ' ' << t << " s";
@@ -499,7 +499,7 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
   referenceConfig.solver.substeps = options.referenceSubsteps;
   referenceConfig.solver.newtonIterations = options.referenceNewtonIterations;
   referenceConfig.solver.cgTolerance = options.referenceCgTolerance;
-  referenceConfig.solver.cgStopping = PcgStopping::RelativeResidual;  // the "residual ≤ 1e-10"
+  referenceConfig.solver.cgStopping = PcgStopping::RelativeResidual;  // the reference: residual ≤ 1e-10
   referenceConfig.solver.tightCgTolerance = 0;  // every substep to the reference's tolerance
   referenceConfig.solver.cgMaxIterations = 5000;
   std::ostringstream keyText;

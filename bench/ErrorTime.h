@@ -1,4 +1,4 @@
-// The error-vs-time sweep of DESIGN.md §6 (weft-error-time): how much accuracy each integrator,
+// The error-vs-time sweep (weft-error-time): how much accuracy each integrator,
 // step size, PCG tolerance and warm-start choice buys per second of wall time on the curtain.
 #pragma once
 
@@ -11,7 +11,7 @@ namespace weft {
 
 /// Options of one sweep (flags in ErrorTimeMain.cpp).
 struct ErrorTimeOptions {
-  std::string scene = "curtain";  ///< the only scene so far: the curtain of DESIGN.md §4
+  std::string scene = "curtain";  ///< the only scene offered: the curtain
   bool quick = false;             ///< ~2 s simulated, a small grid of settings (minutes)
   bool full = false;              ///< every combination, 6 s simulated with the rod gathering
   std::string csvPath;            ///< one row per run; empty = no CSV

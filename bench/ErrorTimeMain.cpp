@@ -1,4 +1,4 @@
-// weft-error-time: command line of the error-vs-time sweep (DESIGN.md §6 and §8).
+// weft-error-time: command line of the error-vs-time sweep.
 // CLI11 is included here and nowhere else: it costs ~12 s of compile time per file.
 #include "ErrorTime.h"
 

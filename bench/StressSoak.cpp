@@ -1,7 +1,7 @@
-// weft-stress-soak: the long variants of the stress suite (issue 9, tests/stress/ holds the short
+// weft-stress-soak: the long variants of the stress suite (tests/stress/ holds the short
 // ones that run in CI).
 //
-//   soak     scene 12: the curtain (DESIGN.md §4 geometry and material, sphere and floor) in a
+//   soak     scene 12: the curtain (its geometry and material, sphere and floor) in a
 //            steady wind for an hour of simulated time, its 10 s script (sphere push, gather,
 //            re-open) repeated throughout (--script off holds the rod still; in a steady wind the
 //            curtain then comes to rest within a minute and the soak measures a cloth at rest). Samples the resident
@@ -242,7 +242,7 @@ int runSteps(int threads) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"weft-stress-soak: long stress runs (issue 9): the hour-long curtain soak in wind, "
+  CLI::App app{"weft-stress-soak: long stress runs: the hour-long curtain soak in wind, "
                "and the full curtain script at every frame step"};
   std::string scene = "soak";
   SoakOptions soak;

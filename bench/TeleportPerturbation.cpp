@@ -1,6 +1,6 @@
 // weft-teleport-perturb: stress scene 10 (tests/stress/PinStressTest.cpp, pins of a hanging
 // cotton sheet teleported 10 m in one frame) run under round-off-level perturbations, to tell a
-// robust recovery from a lucky draw (issue 9).
+// robust recovery from a lucky draw.
 //
 // Each run changes only round-off: the teleport distance by δ (0, 1e-12 … 3e-3 m) and pin removal
 // on or off (the same system solved with or without the pinned rows, 1e-14 relative apart), and

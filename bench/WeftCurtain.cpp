@@ -1,4 +1,4 @@
-// weft-curtain: command line of the curtain runner (flags of DESIGN.md §8).
+// weft-curtain: command line of the curtain runner (flags and report: docs/curtain-benchmark.md).
 // CLI11 is included here and nowhere else: it costs ~12 s of compile time per file.
 #include "CurtainRunner.h"
 
@@ -10,8 +10,8 @@
 
 int main(int argc, char** argv) {
   weft::CurtainRunOptions options;
-  CLI::App app{"Weft curtain benchmark: simulate (and render) the curtain of DESIGN.md §4 and "
-               "report frame times"};
+  CLI::App app{"Weft curtain benchmark: simulate (and render) the curtain scene and report frame "
+               "times (docs/curtain-benchmark.md)"};
   app.add_option("--size", options.size, "Refinement: 1, 4, 16 or 64 times 2,400 triangles")
       ->check(CLI::IsMember({1u, 4u, 16u, 64u}));
   app.add_option("--frames", options.frames, "Frames to run (600 = the 10 s script)")
@@ -35,7 +35,8 @@ int main(int argc, char** argv) {
   app.add_option("--sleep", sleep, "Let the curtain sleep at rest: on or off")
       ->check(CLI::IsMember({"on", "off"}));
   app.add_option("--summary-json", options.summaryJson, "Write the JSON summary here");
-  app.add_option("--csv", options.frameCsv, "Write per-frame statistics here (CSV)");
+  app.add_option("--csv", options.frameCsv,
+                 "Write per-frame statistics here (CSV), and a chart of them beside it (.png, gnuplot)");
   app.add_option("--trace", options.trace,
                  "Record profiler zones and write a Chrome trace here (open in Perfetto)");
   // Names come from the engine (integratorName), so the flag and the reports cannot disagree.

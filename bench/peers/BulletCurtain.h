@@ -1,4 +1,4 @@
-// BulletCurtain: DESIGN.md §4's curtain rebuilt in Bullet's soft body (btSoftBody, the
+// BulletCurtain: the curtain (weft::CurtainScene) rebuilt in Bullet's soft body (btSoftBody, the
 // position-based mass-spring cloth of btSoftRigidDynamicsWorld), for weft-vs-bullet.
 //
 // The scene follows weft::CurtainScene, not a Bullet demo: the same 2.0 m × 1.5 m patch with the

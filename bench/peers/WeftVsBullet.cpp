@@ -1,4 +1,4 @@
-// weft-vs-bullet: the curtain of DESIGN.md §4 in Weft and in Bullet's soft body, in one process,
+// weft-vs-bullet: the curtain in Weft and in Bullet's soft body, in one process,
 // measured by one ruler (ClothMeter), with a markdown table of time, strain, intersections and
 // blow-ups and the ratios Weft / Bullet. Settings of each engine and why: bench/peers/README.md.
 //
@@ -37,7 +37,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 constexpr double kStallFraction = 0.03;  // a point less than 3 % better than the last: stalled
-constexpr double kSpeedTarget = 5.0;     // issue 11: Weft at least 5× faster at equal strain
+constexpr double kSpeedTarget = 5.0;     // the target: Weft at least 5× faster at equal strain
 
 struct Options {
   std::vector<unsigned> sizes{1, 4, 16};
@@ -466,7 +466,7 @@ int run(const Options& options, const std::string& commandLine) {
   std::vector<bool> modes;
   if (options.selfCollision != "on") modes.push_back(false);
   if (options.selfCollision != "off") modes.push_back(true);
-  std::cout << "weft-vs-bullet: the curtain (DESIGN.md §4) in Weft and Bullet " << "(soft body, single precision), "
+  std::cout << "weft-vs-bullet: the curtain in Weft and Bullet " << "(soft body, single precision), "
             << options.frames << " frames"
             << (options.largeFrames ? " (" + std::to_string(options.largeFrames) + " from size 16 on)" : std::string())
             << "\n  machine: " << std::thread::hardware_concurrency()

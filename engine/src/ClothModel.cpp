@@ -2,26 +2,26 @@
 //
 // Validation rejects, with a message naming the element, everything that would later turn into
 // a singular matrix or a NaN: empty meshes, index counts that are not a multiple of three,
-// out-of-range or repeated indices, non-finite positions, zero-area triangles, duplicated
-// triangles, vertices used by no triangle (they would have zero mass) and, when bending needs
-// it, edges shared by more than two triangles.
+// out-of-range or repeated indices, non-finite or far-away positions, zero-area triangles,
+// duplicated triangles, vertices used by no triangle (they would have zero mass) and, when
+// bending needs it, edges shared by more than two triangles and bowtie vertices. fromMesh()
+// welds coincident vertices and orients the triangles first (MeshPreparation.h); sizes are
+// checked against the 32-bit index range and the available memory before anything is allocated.
 //
 // Everything derived (edges, hinges, springs) is built in the order of the input triangles, so a
 // model built twice from the same mesh is identical element for element: later stages rely on
 // this for determinism.
 #include <weft/engine/ClothModel.h>
 
+#include "MeshPreparation.h"
+#include "ObjParser.h"
 #include "forces/BaraffWitkin.h"
 #include "forces/IsometricBending.h"
 
-#include <tiny_obj_loader.h>
+#include <weft/engine/InputFile.h>
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <filesystem>
-#include <fstream>
 #include <sstream>
 #include <unordered_map>
 #include <unordered_set>
@@ -33,12 +33,6 @@ std::uint64_t edgeKey(Index a, Index b) {
   if (a > b) std::swap(a, b);
   return (static_cast<std::uint64_t>(a) << 32) | b;
 }
-
-struct TriangleKeyHash {
-  std::size_t operator()(const std::array<Index, 3>& key) const {
-    return std::hash<std::uint64_t>()(edgeKey(key[0], key[1]) * 0x9E3779B97F4A7C15ull ^ key[2]);
-  }
-};
 
 std::string describeTriangle(Index t, Index a, Index b, Index c) {
   std::ostringstream text;
@@ -67,6 +61,14 @@ std::array<Vec2, 3> flattenTriangle(const Vec3& x0, const Vec3& x1, const Vec3& 
 }
 
 }  // namespace
+
+std::uint64_t ClothModel::estimatedBuildBytes(std::uint64_t vertices, std::uint64_t triangles) {
+  // Measured peaks (bench/results/memory-footprint.md): grid() 1.2-1.5 kB and fromMesh()
+  // 1.7-1.9 kB a vertex on meshes of 2 triangles a vertex; a third more for hash tables that
+  // grow in steps.
+  constexpr std::uint64_t kBytesPerVertex = 1536, kBytesPerTriangle = 512;
+  return kBytesPerVertex * vertices + kBytesPerTriangle * triangles;
+}
 
 std::vector<Real> ClothModel::vertexMasses(Real arealDensity) const {
   std::vector<Real> masses(m_vertexAreas.size());
@@ -97,6 +99,34 @@ Result<ClothModel> ClothModel::grid(const GridSettings& settings) {
       settings.heightAxis.norm() == 0) {
     return Error{"grid widthAxis " + formatVec(settings.widthAxis) + " and heightAxis " +
                  formatVec(settings.heightAxis) + " must be non-zero and perpendicular"};
+  }
+
+  // Every vertex lies within |origin| + width + height of the origin (the axes are unit).
+  const Real farthest = settings.origin.cwiseAbs().maxCoeff() + settings.width + settings.height;
+  if (!(farthest <= kMaxCoordinate)) {
+    std::ostringstream text;
+    text << "grid at origin " << formatVec(settings.origin) << " m, " << settings.width << " m x "
+         << settings.height << " m, reaches beyond the " << kMaxCoordinate
+         << " m a coordinate may have (kMaxCoordinate); build it near the origin and place it "
+            "with ClothSettings::translation";
+    return Error{text.str()};
+  }
+  // Sizes in 64 bits before anything is allocated: the products overflow Index long before.
+  const std::uint64_t vertexCount = std::uint64_t(settings.columns) * settings.rows;
+  const std::uint64_t triangleCount =
+      2 * std::uint64_t(settings.columns - 1) * (settings.rows - 1);
+  const std::string size =
+      "grid of " + std::to_string(settings.columns) + " x " + std::to_string(settings.rows) + " vertices";
+  if (vertexCount >= kInvalidIndex || triangleCount >= kInvalidIndex) {
+    return Error{size + " has " + std::to_string(vertexCount) + " vertices and " +
+                 std::to_string(triangleCount) + " triangles; a cloth model holds at most " +
+                 std::to_string(kInvalidIndex - 1) +
+                 " of each (32-bit indices): use fewer columns and rows"};
+  }
+  if (Status memory = checkMemory(estimatedBuildBytes(vertexCount, triangleCount), size,
+                                  "use fewer columns and rows");
+      !memory.ok()) {
+    return memory.error();
   }
 
   const Index columns = settings.columns;
@@ -130,7 +160,7 @@ Result<ClothModel> ClothModel::grid(const GridSettings& settings) {
   std::vector<Vec2> perCorner;
   perCorner.reserve(mesh.indices.size());
   for (Index index : mesh.indices) perCorner.push_back(mesh.materialCoordinates[index]);
-  Result<ClothModel> built = build(mesh, MeshSettings{}, perCorner);
+  Result<ClothModel> built = build(mesh, MeshSettings{}, perCorner, {}, {}, /*meshSprings=*/false);
   if (!built.ok()) return built;
   ClothModel& model = built.value();
   model.m_gridSize = {columns, rows};
@@ -168,6 +198,19 @@ Result<ClothModel> ClothModel::fromMesh(const TriangleMesh& mesh, const MeshSett
     return Error{"MeshSettings::warpDirection " + formatVec(settings.warpDirection) +
                  " must be a finite, non-zero vector"};
   }
+  if (!(settings.degenerateAreaRatio >= 0 && settings.degenerateAreaRatio < 0.5)) {
+    std::ostringstream text;
+    text << "MeshSettings::degenerateAreaRatio = " << settings.degenerateAreaRatio
+         << " must be at least 0 and below 0.5 (an equilateral triangle has 0.43)";
+    return Error{text.str()};
+  }
+  if (!(settings.weldTolerance >= 0 && settings.weldTolerance < 1)) {
+    std::ostringstream text;
+    text << "MeshSettings::weldTolerance = " << settings.weldTolerance
+         << " (a fraction of the mesh's bounding-box diagonal) must be at least 0 and below 1; "
+            "the default is 1e-6";
+    return Error{text.str()};
+  }
   if (!mesh.materialCoordinates.empty() &&
       mesh.materialCoordinates.size() != mesh.positions.size()) {
     return Error{"mesh has " + std::to_string(mesh.materialCoordinates.size()) +
@@ -180,52 +223,37 @@ Result<ClothModel> ClothModel::fromMesh(const TriangleMesh& mesh, const MeshSett
                    " is NaN or infinite; give finite (u, v) in metres"};
     }
   }
-  // Per-corner material coordinates: given, or from flattening each triangle on its own. Shape
-  // checks on indices come first in build(); flattening needs valid indices, so it is deferred
-  // by passing an empty list and letting build() flatten after validation.
-  return build(mesh, settings, {});
+  const std::string size = "mesh of " + std::to_string(mesh.positions.size()) + " vertices and " +
+                           std::to_string(mesh.indices.size() / 3) + " triangles";
+  if (Status memory = checkMemory(estimatedBuildBytes(mesh.positions.size(), mesh.indices.size() / 3),
+                                  size, "simplify the mesh");
+      !memory.ok()) {
+    return memory.error();
+  }
+  Result<PreparedMesh> prepared = prepareMesh(mesh, settings);
+  if (!prepared.ok()) return prepared.error();
+  PreparedMesh& ready = prepared.value();
+  // Per-corner material coordinates: given through a weld, or else from the per-vertex ones or
+  // from flattening each triangle on its own (build() does both after its checks).
+  Result<ClothModel> model = build(ready.mesh, settings, ready.perCornerMaterialCoordinates,
+                                   ready.inputOfModel, ready.bowtieVertices, /*meshSprings=*/true);
+  if (!model.ok()) return model;
+  model->m_meshImport = std::move(ready.import);
+  return model;
 }
 
 Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSettings& settings,
-                                     const std::vector<Vec2>& perCornerMaterialCoordinates) {
+                                     const std::vector<Vec2>& perCornerMaterialCoordinates,
+                                     const std::vector<Index>& inputOfModel,
+                                     const std::vector<Index>& bowtieVertices, bool meshSprings) {
+  // Shapes, ranges and duplicates were checked by prepareMesh() (or hold by construction for a
+  // grid); what is left needs the geometry.
   const std::size_t vertexCount = mesh.positions.size();
-  if (vertexCount == 0 || mesh.indices.empty()) {
-    return Error{"mesh is empty (" + std::to_string(vertexCount) + " vertices, " +
-                 std::to_string(mesh.indices.size()) +
-                 " indices): a cloth needs at least one triangle"};
-  }
-  if (vertexCount >= kInvalidIndex) {
-    return Error{"mesh has " + std::to_string(vertexCount) + " vertices; at most " +
-                 std::to_string(kInvalidIndex - 1) + " are supported"};
-  }
-  if (mesh.indices.size() % 3 != 0) {
-    return Error{"mesh has " + std::to_string(mesh.indices.size()) +
-                 " indices, not a multiple of 3: give three indices per triangle"};
-  }
-  for (std::size_t i = 0; i < vertexCount; ++i) {
-    if (!mesh.positions[i].allFinite()) {
-      return Error{"position of vertex " + std::to_string(i) + " is " +
-                   formatVec(mesh.positions[i]) + ": every position must be finite"};
-    }
-  }
-
   const Index triangleCount = static_cast<Index>(mesh.indices.size() / 3);
-  std::vector<Index> useCount(vertexCount, 0);
-  std::unordered_set<std::array<Index, 3>, TriangleKeyHash> seenTriangles;
+  auto input = [&](Index v) { return inputOfModel.empty() ? v : inputOfModel[v]; };
+  std::vector<std::uint8_t> used(vertexCount, 0);
   for (Index t = 0; t < triangleCount; ++t) {
     const Index a = mesh.indices[3 * t], b = mesh.indices[3 * t + 1], c = mesh.indices[3 * t + 2];
-    for (Index index : {a, b, c}) {
-      if (index >= vertexCount) {
-        return Error{describeTriangle(t, a, b, c) + ": index " + std::to_string(index) +
-                     " is out of range; the mesh has " + std::to_string(vertexCount) +
-                     " vertices (valid indices 0.." + std::to_string(vertexCount - 1) + ")"};
-      }
-    }
-    if (a == b || b == c || a == c) {
-      const Index repeated = (a == b || a == c) ? a : b;
-      return Error{describeTriangle(t, a, b, c) + ": repeated vertex index " +
-                   std::to_string(repeated) + "; every triangle needs three distinct vertices"};
-    }
     const Vec3& x0 = mesh.positions[a];
     const Vec3& x1 = mesh.positions[b];
     const Vec3& x2 = mesh.positions[c];
@@ -234,24 +262,16 @@ Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSetting
         std::max({(x1 - x0).norm(), (x2 - x1).norm(), (x0 - x2).norm()});
     if (!(twiceArea > 2 * settings.degenerateAreaRatio * longestEdge * longestEdge)) {
       std::ostringstream text;
-      text << describeTriangle(t, a, b, c) << ": degenerate, area " << 0.5 * twiceArea
-           << " m² for a longest edge of " << longestEdge
+      text << describeTriangle(t, input(a), input(b), input(c)) << ": degenerate, area "
+           << 0.5 * twiceArea << " m² for a longest edge of " << longestEdge
            << " m; remove it or move its vertices apart";
       return Error{text.str()};
     }
-    std::array<Index, 3> sorted{a, b, c};
-    std::sort(sorted.begin(), sorted.end());
-    if (!seenTriangles.insert(sorted).second) {
-      return Error{describeTriangle(t, a, b, c) +
-                   ": the same three vertices form an earlier triangle; remove the duplicate"};
-    }
-    ++useCount[a];
-    ++useCount[b];
-    ++useCount[c];
+    used[a] = used[b] = used[c] = 1;
   }
   for (std::size_t i = 0; i < vertexCount; ++i) {
-    if (useCount[i] == 0) {
-      return Error{"vertex " + std::to_string(i) +
+    if (!used[i]) {
+      return Error{"vertex " + std::to_string(input(Index(i))) +
                    " is used by no triangle (it would have no mass); remove it from the mesh"};
     }
   }
@@ -282,7 +302,7 @@ Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSetting
     const Real uvLongest = std::max({(uv[1] - uv[0]).norm(), (uv[2] - uv[1]).norm(),
                                      (uv[0] - uv[2]).norm()});
     if (!(uvTwiceArea > 2 * settings.degenerateAreaRatio * uvLongest * uvLongest)) {
-      return Error{describeTriangle(t, corners[0], corners[1], corners[2]) +
+      return Error{describeTriangle(t, input(corners[0]), input(corners[1]), input(corners[2])) +
                    ": its material coordinates (u, v) are degenerate (zero area); give each "
                    "triangle a non-degenerate (u, v) layout"};
     }
@@ -312,8 +332,8 @@ Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSetting
       if (edge.triangles[1] == kInvalidIndex) {
         edge.triangles[1] = t;
       } else if (settings.requireManifold) {
-        return Error{"edge (" + std::to_string(edge.vertices[0]) + ", " +
-                     std::to_string(edge.vertices[1]) + ") is shared by triangles " +
+        return Error{"edge (" + std::to_string(input(edge.vertices[0])) + ", " +
+                     std::to_string(input(edge.vertices[1])) + ") is shared by triangles " +
                      std::to_string(edge.triangles[0]) + ", " + std::to_string(edge.triangles[1]) +
                      " and " + std::to_string(t) +
                      ": non-manifold; bending needs at most two triangles per edge (split the "
@@ -354,7 +374,7 @@ Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSetting
   }
   // Isometric bending stencils; they need the non-manifold marks, cleared just below.
   BendingStencils stencils =
-      buildBendingStencils(model.m_restPositions, model.m_indices, model.m_edges);
+      buildBendingStencils(model.m_restPositions, model.m_indices, model.m_edges, bowtieVertices);
   model.m_bendingStencils = std::move(stencils.stencils);
   model.m_bendingWeights = std::move(stencils.weights);
   model.m_bendingTriangles = std::move(stencils.triangles);
@@ -371,7 +391,7 @@ Result<ClothModel> ClothModel::build(const TriangleMesh& mesh, const MeshSetting
   model.m_characteristicLength = (upper - lower).norm();
 
   // Mass-spring network for general meshes; grid() replaces it with the classic one.
-  if (perCornerMaterialCoordinates.empty()) model.buildMeshSprings();
+  if (meshSprings) model.buildMeshSprings();
   return model;
 }
 
@@ -407,74 +427,32 @@ void ClothModel::buildMeshSprings() {
 }
 
 Result<TriangleMesh> ClothModel::readObj(const std::string& path) {
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream text;
-  if (file) text << file.rdbuf();
-  if (!file || std::filesystem::is_directory(path)) {
-    return Error{"cannot read OBJ file '" + path + "': " +
-                 (file ? std::string("it is a directory") : std::string(std::strerror(errno))) +
-                 "; check the path, the permissions and that it is a Wavefront OBJ file"};
+  Result<std::string> text = readInputFile(path, kMaxObjFileBytes, "OBJ file");
+  if (!text.ok()) return text.error();
+  // Parsing holds up to 3 bytes per byte of text ("v 0 0 0" is 8 bytes of text, 24 of position).
+  if (Status memory = checkMemory(3 * std::uint64_t(text->size()), "reading OBJ file '" + path + "'",
+                                  "simplify the mesh");
+      !memory.ok()) {
+    return memory.error();
   }
-  return parseObj(text.str(), "OBJ file '" + path + "'");
+  return parseObj(text.value(), "OBJ file '" + path + "'");
 }
 
 Result<TriangleMesh> ClothModel::parseObj(std::string_view text, std::string_view source) {
-  tinyobj::ObjReaderConfig config;
-  config.triangulate = true;  // polygons become fans
-  config.vertex_color = false;
-  tinyobj::ObjReader reader;
-  // No material library: a cloth model takes nothing from one, and reading from memory keeps
-  // the parse free of file access (so it can be fuzzed).
-  if (!reader.ParseFromString(std::string(text), std::string(), config)) {
-    std::string reason = reader.Error();
-    while (!reason.empty() && (reason.back() == '\n' || reason.back() == '\r')) reason.pop_back();
-    return Error{"cannot read " + std::string(source) + ": " +
-                 (reason.empty() ? std::string("unknown parse error") : reason) +
-                 "; check that it is a Wavefront OBJ file"};
-  }
-  const std::string name(source);
-  const tinyobj::attrib_t& attributes = reader.GetAttrib();
-  TriangleMesh mesh;
-  const std::size_t vertexCount = attributes.vertices.size() / 3;
-  mesh.positions.reserve(vertexCount);
-  for (std::size_t i = 0; i < vertexCount; ++i) {
-    mesh.positions.emplace_back(attributes.vertices[3 * i], attributes.vertices[3 * i + 1],
-                                attributes.vertices[3 * i + 2]);
-  }
-  for (const tinyobj::shape_t& shape : reader.GetShapes()) {
-    std::size_t offset = 0;
-    for (std::size_t face = 0; face < shape.mesh.num_face_vertices.size(); ++face) {
-      const std::size_t corners = shape.mesh.num_face_vertices[face];
-      if (corners != 3) {
-        return Error{name + ", shape '" + shape.name + "', face " +
-                     std::to_string(face) + ": has " + std::to_string(corners) +
-                     " corners after triangulation; give faces of at least three vertices"};
-      }
-      for (std::size_t k = 0; k < 3; ++k) {
-        const int index = shape.mesh.indices[offset + k].vertex_index;
-        if (index < 0 || std::size_t(index) >= vertexCount) {
-          return Error{name + ", shape '" + shape.name + "', face " +
-                       std::to_string(face) + ": vertex index " + std::to_string(index + 1) +
-                       " is out of range (the file has " + std::to_string(vertexCount) +
-                       " vertices)"};
-        }
-        mesh.indices.push_back(static_cast<Index>(index));
-      }
-      offset += corners;
-    }
-  }
-  if (mesh.indices.empty()) {
-    return Error{name + " has no faces; a cloth needs at least one triangle"};
-  }
-  return mesh;
+  return parseObjText(text, source);
 }
 
 Result<ClothModel> ClothModel::loadObj(const std::string& path, const MeshSettings& settings) {
   Result<TriangleMesh> mesh = readObj(path);
   if (!mesh.ok()) return mesh.error();
   Result<ClothModel> model = fromMesh(mesh.value(), settings);
-  // A mesh problem found after reading (NaN, degenerate or repeated corners...) names the file too.
-  if (!model.ok()) return Error{"OBJ file '" + path + "': " + model.error().message};
+  // A mesh problem found after reading (degenerate or repeated corners...) names the file too,
+  // and how its numbers count.
+  if (!model.ok()) {
+    return Error{"OBJ file '" + path + "': " + model.error().message +
+                 " (vertices and triangles count from 0 here: vertex i is the file's 'v' line "
+                 "i + 1, triangle t its t-th triangle after polygons are split)"};
+  }
   return model;
 }
 

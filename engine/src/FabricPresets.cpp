@@ -78,13 +78,13 @@ bool equalsIgnoringCase(std::string_view a, std::string_view b) {
 }  // namespace
 
 ClothMaterial cottonFabric() {
-  // DESIGN.md §4 curtain material: the defaults plus a strain limit (a test checks it).
+  // The curtain's material: the defaults plus a strain limit (a test checks it).
   // In KES terms: 0.15 kg/m² is a 150 g/m² shirting; D = 2.3e-6 N·m is B ≈ 0.023 gf·cm²/cm (a
   // light lawn; shirting is 0.05–0.1) [KES]; 100 N/m shear is G ≈ 1.8 gf/(cm·deg) [KES];
   // 260 N/m stretch lies within [W11]'s low-strain slopes (2·C: 33 N/m for the cotton/polyester
   // interlock up to 2028 N/m for the denim weft). Strain limit 0.10: plain-woven cotton's
   // low-strain regime ends at about 10 % [EST, Provot 1995's threshold]; the defaults leave the
-  // limiter off (ClothMaterial::strainLimit says why), the preset turns it on.
+  // limiter off, the preset turns it on.
   ClothMaterial material;
   material.strainLimit = 0.10;
   return material;

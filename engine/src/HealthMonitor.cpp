@@ -2,6 +2,8 @@
 
 #include "Cloth.h"
 
+#include <weft/engine/InputLimits.h>
+
 #include <algorithm>
 
 namespace weft {
@@ -9,7 +11,7 @@ namespace {
 
 // m/s: no cloth motion comes near it (a 250 m/s projectile drags cloth at 250 m/s), while a
 // blown-up explicit step passes it within a few substeps.
-constexpr Real kDivergedSpeed = 1e4;
+constexpr Real kDivergedSpeed = kMaxSpeed;
 // Strain (l / l_rest − 1) of a diverged integration: cloth tears long before.
 constexpr Real kDivergedStrain = 99;
 // Kinetic energy beyond this multiple of what the frame could supply: energy from nowhere.

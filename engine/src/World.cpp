@@ -4,6 +4,7 @@
 #include "FrameCostModel.h"
 #include "SubstepPipeline.h"
 
+#include <weft/engine/InputFile.h>
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <cmath>
 #include <cstring>
 #include <optional>
+#include <sstream>
 
 namespace weft {
 
@@ -87,17 +89,168 @@ namespace {
 std::atomic<std::uint64_t> g_nextWorldIdentity{1};
 }  // namespace
 
+namespace {
+std::string formatVector(const Vec3& v) {
+  std::ostringstream text;
+  text << "(" << v.x() << ", " << v.y() << ", " << v.z() << ")";
+  return text.str();
+}
+
+// Empty when `gravity` is finite and within kMaxGravity; else what is wrong, for `field`.
+std::string gravityProblem(const Vec3& gravity, const std::string& field) {
+  if (!gravity.allFinite()) {
+    return field + " contains NaN or infinity (gravity or wind must be finite); give m/s²";
+  }
+  if (gravity.norm() <= kMaxGravity) return {};
+  std::ostringstream text;
+  text << field << " " << formatVector(gravity) << " m/s² is stronger than " << kMaxGravity
+       << " m/s² (kMaxGravity: a second of fall would reach " << kMaxSpeed
+       << " m/s, which the engine treats as divergence); give a gravity within it";
+  return text.str();
+}
+
+// Empty when `wind` is finite and within kMaxSpeed; else what is wrong, for `field`.
+std::string windProblem(const Vec3& wind, const std::string& field) {
+  if (!wind.allFinite()) {
+    return field + " contains NaN or infinity (gravity or wind must be finite); give m/s";
+  }
+  if (wind.norm() <= kMaxSpeed) return {};
+  std::ostringstream text;
+  text << field << " " << formatVector(wind) << " m/s is faster than " << kMaxSpeed
+       << " m/s (kMaxSpeed, which the engine treats as divergence); give a wind within it";
+  return text.str();
+}
+
+// Why `settings` cannot make a world, naming the field and the fix; empty when they can.
+std::string settingsProblem(const WorldSettings& settings) {
+  if (std::string problem = gravityProblem(settings.gravity, "world settings: WorldSettings::gravity");
+      !problem.empty()) {
+    return problem;
+  }
+  if (std::string problem = windProblem(settings.wind, "world settings: WorldSettings::wind");
+      !problem.empty()) {
+    return problem;
+  }
+  if (!settings.taskSystem && !validate(TaskSystemSettings{settings.threadCount}).empty()) {
+    return "world settings: WorldSettings::threadCount = " + std::to_string(settings.threadCount) +
+           " is out of range: give 0 (the machine's cores), 1 (serial) or up to " +
+           std::to_string(TaskSystemSettings::kMaxThreadCount) + " threads";
+  }
+  return {};
+}
+
+// Every material, spring and mass value of `settings` within kMaxMaterialValue (signs, NaN and
+// infinity are Cloth::create's checks, with their own messages).
+Status checkMagnitudes(const ClothSettings& settings) {
+  const ClothMaterial& m = settings.material;
+  const MassSpringMaterial& s = settings.springs;
+  const struct {
+    const char* field;
+    Real value;
+    const char* unit;
+  } fields[] = {
+      {"material.arealDensity", m.arealDensity, "kg/m²"},
+      {"material.warpStretchStiffness", m.warpStretchStiffness, "N/m"},
+      {"material.weftStretchStiffness", m.weftStretchStiffness, "N/m"},
+      {"material.shearStiffness", m.shearStiffness, "N/m"},
+      {"material.bendingStiffness", m.bendingStiffness, "N·m"},
+      {"material.warpRestScale", m.warpRestScale, ""},
+      {"material.weftRestScale", m.weftRestScale, ""},
+      {"material.stretchDamping", m.stretchDamping, "N·s/m"},
+      {"material.shearDamping", m.shearDamping, "N·s/m"},
+      {"material.bendingDamping", m.bendingDamping, "N·m·s"},
+      {"material.airDrag", m.airDrag, "N·s/m³"},
+      {"material.thickness", m.thickness, "m"},
+      {"material.friction", m.friction, ""},
+      {"springs.structuralStiffness", s.structuralStiffness, "N/m"},
+      {"springs.shearStiffness", s.shearStiffness, "N/m"},
+      {"springs.flexionStiffness", s.flexionStiffness, "N/m"},
+      {"springs.structuralDamping", s.structuralDamping, "N·s/m"},
+      {"springs.shearDamping", s.shearDamping, "N·s/m"},
+      {"springs.flexionDamping", s.flexionDamping, "N·s/m"},
+      {"solver.selfContactStiffness", settings.solver.selfContactStiffness, ""},
+  };
+  auto tooLarge = [](const std::string& field, Real value, const char* unit) {
+    std::ostringstream text;
+    text << "cloth settings: " << field << " = " << value << (*unit ? " " : "") << unit
+         << " is above " << kMaxMaterialValue
+         << " (kMaxMaterialValue), the largest value whose products the solver's arithmetic "
+            "carries; give a physical value (a stiffer cloth is better made with "
+            "material.strainLimit)";
+    return Error{text.str()};
+  };
+  for (const auto& field : fields) {
+    if (std::isfinite(field.value) && field.value > kMaxMaterialValue) {
+      return tooLarge(field.field, field.value, field.unit);
+    }
+  }
+  for (std::size_t i = 0; i < settings.vertexMasses.size(); ++i) {
+    const Real mass = settings.vertexMasses[i];
+    if (std::isfinite(mass) && mass > kMaxMaterialValue) {
+      return tooLarge("vertexMasses[" + std::to_string(i) + "]", mass, "kg");
+    }
+  }
+  return Status::success();
+}
+
+// The first vector of `values` longer than `limit`, as an error "<name(k)> is (x, y, z) <unit>,
+// <comparison> <limit> <unit> (<why>)"; non-finite ones are the callee's check.
+template <typename Name>
+Status checkLength(std::span<const Vec3> values, Real limit, Name name, const char* comparison,
+                   const char* unit, const char* why) {
+  for (std::size_t k = 0; k < values.size(); ++k) {
+    if (!values[k].allFinite() || values[k].norm() <= limit) continue;
+    std::ostringstream text;
+    text << name(k) << " is " << formatVector(values[k]) << " " << unit << ", " << comparison << " "
+         << limit << " " << unit << " (" << why << "); give a value within it";
+    return Error{text.str()};
+  }
+  return Status::success();
+}
+
+// The first point of `points` with a coordinate beyond kMaxCoordinate, as an error of
+// `operation` that calls point k "<what> k"; success when there is none.
+Status checkReach(std::span<const Vec3> points, const char* operation, const char* what) {
+  for (std::size_t k = 0; k < points.size(); ++k) {
+    // Non-finite values are the cloth's own check (with its message).
+    if (!points[k].allFinite() || points[k].cwiseAbs().maxCoeff() <= kMaxCoordinate) continue;
+    std::ostringstream text;
+    text << operation << ": " << what << " " << k << " is at (" << points[k].x() << ", "
+         << points[k].y() << ", " << points[k].z() << ") m, beyond the " << kMaxCoordinate
+         << " m a coordinate may have (kMaxCoordinate, where doubles still resolve 0.1 nm); keep "
+            "the simulation near the origin (move the origin with the player)";
+    return Error{text.str()};
+  }
+  return Status::success();
+}
+}  // namespace
+
+Result<World> World::create(const WorldSettings& settings) {
+  if (std::string problem = settingsProblem(settings); !problem.empty()) return Error{problem};
+  return World(settings);
+}
+
 World::World(const WorldSettings& settings)
     : m_settings(settings),
       m_costModel(std::make_unique<FrameCostModel>()),
-      m_identity(g_nextWorldIdentity.fetch_add(1)) {
+      m_identity(g_nextWorldIdentity.fetch_add(1)),
+      m_settingsError(settingsProblem(settings)) {
   if (settings.taskSystem) {
     m_tasks = settings.taskSystem;
   } else {
-    m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{std::max(0, settings.threadCount)});
+    // An invalid count gives the serial TaskSystem; createCloth() reports the mistake.
+    m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{settings.threadCount});
     m_tasks = m_ownedTasks.get();
   }
   m_pipeline = std::make_unique<SubstepPipeline>(m_tasks, settings.skipUnneededStages);
+}
+
+std::uint64_t World::estimatedClothBytes(std::uint64_t vertices, std::uint64_t triangles) {
+  // Measured peaks (bench/results/memory-footprint.md): 5.9-6.2 kB a vertex for createCloth()
+  // and the first frames of a hanging cloth of 2 triangles a vertex; a third more for buffers
+  // that grow in steps and for contacts.
+  constexpr std::uint64_t kBytesPerVertex = 4096, kBytesPerTriangle = 2048;
+  return kBytesPerVertex * vertices + kBytesPerTriangle * triangles;
 }
 
 int World::threadCount() const { return m_tasks->threadCount(); }
@@ -135,8 +288,31 @@ Error staleHandle(const char* operation, ClothId id) {
 
 Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
                                    const ClothSettings& settings) {
-  if (!m_settings.gravity.allFinite() || !m_settings.wind.allFinite()) {
-    return Error{"world settings: gravity or wind contains NaN or infinity"};
+  if (!m_settingsError.empty()) return Error{m_settingsError};
+  if (Status magnitudes = checkMagnitudes(settings); !magnitudes.ok()) return magnitudes.error();
+  if (model) {
+    // Where the vertices start: rest positions turned and moved by the settings (the pose
+    // itself is checked by Cloth::create).
+    if (settings.translation.allFinite() && settings.rotation.allFinite()) {
+      for (Index i = 0; i < model->vertexCount(); ++i) {
+        const Vec3 x = settings.rotation * model->restPositions()[i] + settings.translation;
+        if (!(x.cwiseAbs().maxCoeff() > kMaxCoordinate)) continue;
+        std::ostringstream text;
+        text << "cloth settings: translation (" << settings.translation.x() << ", "
+             << settings.translation.y() << ", " << settings.translation.z() << ") m puts vertex "
+             << i << " at (" << x.x() << ", " << x.y() << ", " << x.z() << ") m, beyond the "
+             << kMaxCoordinate
+             << " m a coordinate may have (kMaxCoordinate, where doubles still resolve 0.1 nm); "
+                "keep the simulation near the origin (move the origin with the player)";
+        return Error{text.str()};
+      }
+    }
+    if (Status memory = checkMemory(estimatedClothBytes(model->vertexCount(), model->triangleCount()),
+                                    "a cloth of " + std::to_string(model->vertexCount()) + " vertices",
+                                    "use a coarser model");
+        !memory.ok()) {
+      return memory.error();
+    }
   }
   Result<std::unique_ptr<Cloth>> cloth =
       Cloth::create(std::move(model), settings, m_settings, m_tasks);
@@ -156,6 +332,14 @@ Result<ColliderId> World::addCollider(const Shape& shape, const ColliderSettings
   if (!(std::isfinite(settings.friction) && settings.friction >= 0)) {
     return Error{"addCollider: friction = " + std::to_string(settings.friction) +
                  " must be finite and at least 0"};
+  }
+  const Vec3 velocity = motion(shape).linearVelocity;
+  if (Status speed = checkLength(
+          std::span<const Vec3>(&velocity, 1), kMaxSpeed,
+          [](std::size_t) { return std::string("addCollider: the collider's linear velocity"); },
+          "faster than", "m/s", "kMaxSpeed, which the engine treats as divergence");
+      !speed.ok()) {
+    return speed.error();
   }
   for (std::size_t k = 0; k < m_colliderSlots.size(); ++k) {
     if (!m_colliderSlots[k]->shape) {
@@ -193,6 +377,13 @@ Status World::destroyCollider(ColliderId id) {
 Status World::setColliderMotion(ColliderId id, const RigidMotion& motion) {
   ColliderSlot* slot = find(id);
   if (!slot) return staleCollider("setColliderMotion", id);
+  if (Status speed = checkLength(
+          std::span<const Vec3>(&motion.linearVelocity, 1), kMaxSpeed,
+          [](std::size_t) { return std::string("setColliderMotion: the linear velocity"); },
+          "faster than", "m/s", "kMaxSpeed, which the engine treats as divergence");
+      !speed.ok()) {
+    return speed;
+  }
   return setMotion(*slot->shape, motion);
 }
 
@@ -214,6 +405,10 @@ Status World::destroyCloth(ClothId id) {
 Status World::setPinTargets(ClothId id, std::span<const Vec3> targets) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("setPinTargets", id);
+  // Counts are the cloth's check (with its message); values are looked at once they match.
+  if (targets.size() == slot->cloth->pinTargets().size()) {
+    if (Status reach = checkReach(targets, "setPinTargets", "target"); !reach.ok()) return reach;
+  }
   return slot->cloth->setPinTargets(targets);
 }
 
@@ -289,6 +484,16 @@ Result<Index> World::attachedVertexCount(ClothId id) const {
 Status World::setExternalForces(ClothId id, std::span<const Vec3> forces) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("setExternalForces", id);
+  if (!forces.empty() && forces.size() != slot->cloth->vertexCount()) {
+    return slot->cloth->setExternalForces(forces);  // refuses the count, naming it
+  }
+  if (Status size = checkLength(
+          forces, kMaxMaterialValue,
+          [](std::size_t k) { return "setExternalForces: the force on vertex " + std::to_string(k); },
+          "larger than", "N", "kMaxMaterialValue, beyond which the solver's arithmetic overflows");
+      !size.ok()) {
+    return size;
+  }
   return slot->cloth->setExternalForces(forces);
 }
 
@@ -296,7 +501,11 @@ Status World::setWind(const Vec3& wind) {
   if (!wind.allFinite()) {
     return Error{"setWind: the wind velocity is NaN or infinite; give it in m/s"};
   }
+  if (std::string problem = windProblem(wind, "setWind: the wind"); !problem.empty()) {
+    return Error{problem};
+  }
   m_settings.wind = wind;
+  m_settingsError = settingsProblem(m_settings);
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
     if (slot->cloth) slot->cloth->setExternalFields(m_settings.gravity, m_settings.wind);
   }
@@ -307,6 +516,16 @@ Status World::setState(ClothId id, std::span<const Vec3> positions,
                        std::span<const Vec3> velocities) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("setState", id);
+  const std::size_t n = slot->cloth->vertexCount();
+  if (positions.size() != n || velocities.size() != n) return slot->cloth->setState(positions, velocities);
+  if (Status reach = checkReach(positions, "setState", "vertex"); !reach.ok()) return reach;
+  if (Status speed = checkLength(
+          velocities, kMaxSpeed,
+          [](std::size_t k) { return "setState: the velocity of vertex " + std::to_string(k); },
+          "faster than", "m/s", "kMaxSpeed, which the engine treats as divergence");
+      !speed.ok()) {
+    return speed;
+  }
   return slot->cloth->setState(positions, velocities);
 }
 
@@ -335,7 +554,11 @@ void World::updateAttachedPins(Real frameDt) {
 
 Status World::setGravity(const Vec3& gravity) {
   if (!gravity.allFinite()) return Error{"setGravity: gravity contains NaN or infinity"};
+  if (std::string problem = gravityProblem(gravity, "setGravity: gravity"); !problem.empty()) {
+    return Error{problem};
+  }
   m_settings.gravity = gravity;
+  m_settingsError = settingsProblem(m_settings);
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
     if (slot->cloth) slot->cloth->setExternalFields(m_settings.gravity, m_settings.wind);
   }
@@ -418,7 +641,8 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
   const auto start = std::chrono::steady_clock::now();
   Profiler::instance().beginFrame(m_stats.frame + 1);
   WEFT_PROFILE_ZONE("step");
-  if (!(std::isfinite(frameDt) && frameDt > 0)) {
+  // The world's clock must stay finite too (two frames of 1e308 s would not).
+  if (!(std::isfinite(frameDt) && frameDt > 0 && std::isfinite(m_time + frameDt))) {
     m_stats.status = StepStatus::InvalidInput;
     return m_stats.status;
   }

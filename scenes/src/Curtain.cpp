@@ -14,6 +14,14 @@ Real smoothstep(Real s) {
 
 }  // namespace
 
+std::span<const CurtainPhase> CurtainScene::phases() {
+  static constexpr CurtainPhase kPhases[] = {
+      {0, 1, "settle"},        {1, 2, "sphere pushes"}, {2, 3, "sphere withdraws"},
+      {3, 4, "swing"},         {4, 6, "rod gathers"},   {6, 8, "hold"},
+      {8, 10, "rod opens"}};
+  return kPhases;
+}
+
 std::array<Index, 2> CurtainScene::gridSize(Index size) {
   const Index refinement = size == 64 ? 8 : size == 16 ? 4 : size == 4 ? 2 : 1;
   return {40 * refinement + 1, 30 * refinement + 1};
@@ -55,7 +63,9 @@ Result<CurtainScene> CurtainScene::create(const CurtainSettings& settings) {
   worldSettings.threadCount = settings.threadCount;
   worldSettings.taskSystem = settings.taskSystem;
   worldSettings.skipUnneededStages = settings.skipUnneededStages;
-  scene.m_world = std::make_unique<World>(worldSettings);
+  Result<World> world = World::create(worldSettings);
+  if (!world.ok()) return Error{"curtain settings: " + world.error().message};
+  scene.m_world = std::make_unique<World>(std::move(world).value());
   scene.m_pinScript = settings.pinScript;
 
   ClothSettings cloth;

@@ -7,13 +7,13 @@
 #include <weft/scenes/SceneFile.h>
 
 #include <weft/engine/FabricPresets.h>
+#include <weft/engine/InputFile.h>
 
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <initializer_list>
 #include <set>
 #include <sstream>
@@ -302,6 +302,43 @@ std::string resolvePath(const std::string& file, const std::string& baseDirector
   return (std::filesystem::path(baseDirectory) / path).lexically_normal().string();
 }
 
+// readReal for a material, spring or mass value, which must also stay within kMaxMaterialValue
+// (World::createCloth refuses larger ones).
+bool readMaterialValue(Reader& reader, const Json& object, const std::string& path,
+                       std::string_view key, Real& out, Range range, std::string_view unit) {
+  Real value = out;
+  if (!reader.readReal(object, path, key, value, range, unit)) return false;
+  if (value > kMaxMaterialValue) {
+    reader.fail(child(path, key), "is " + formatNumber(value) + ", above " +
+                                      formatNumber(kMaxMaterialValue) +
+                                      " (kMaxMaterialValue, the largest value the solver's "
+                                      "arithmetic carries); give a physical value");
+    return false;
+  }
+  out = value;
+  return true;
+}
+
+// A velocity within kMaxSpeed (World refuses faster ones); else an issue at `path`.
+void checkSpeed(Reader& reader, const std::string& path, const Vec3& velocity, std::string_view what) {
+  if (velocity.norm() <= kMaxSpeed) return;
+  reader.fail(path, "is " + formatNumber(velocity.norm()) + " m/s, faster than " +
+                        formatNumber(kMaxSpeed) + " m/s (kMaxSpeed), which the engine treats as "
+                        "divergence; give " + std::string(what) + " a speed within it");
+}
+
+// A cloth of this size, model and world state together, fits in the available memory; else an
+// issue at `path` naming `what` and the fix.
+bool checkClothMemory(Reader& reader, const std::string& path, const std::string& what,
+                      std::uint64_t vertices, std::uint64_t triangles, std::string_view fix) {
+  const std::uint64_t bytes = ClothModel::estimatedBuildBytes(vertices, triangles) +
+                              World::estimatedClothBytes(vertices, triangles);
+  Status memory = checkMemory(bytes, "a cloth of " + std::to_string(vertices) + " vertices (" + what + ")", fix);
+  if (memory.ok()) return true;
+  reader.fail(path, memory.error().message);
+  return false;
+}
+
 // Reads an OBJ file and checks its size against the limits; null on failure (issue recorded).
 std::optional<TriangleMesh> readMesh(Reader& reader, const std::string& path,
                                      const std::string& file) {
@@ -336,19 +373,19 @@ void readMaterial(Reader& reader, const Json& object, const std::string& path, C
     if (material.ok()) m = material.value();
     else reader.fail(child(path, "preset"), material.error().message);
   }
-  reader.readReal(object, path, "arealDensity", m.arealDensity, Range::Positive, "kg/m²");
-  reader.readReal(object, path, "warpStretchStiffness", m.warpStretchStiffness, Range::NonNegative, "N/m");
-  reader.readReal(object, path, "weftStretchStiffness", m.weftStretchStiffness, Range::NonNegative, "N/m");
-  reader.readReal(object, path, "shearStiffness", m.shearStiffness, Range::NonNegative, "N/m");
-  reader.readReal(object, path, "bendingStiffness", m.bendingStiffness, Range::NonNegative, "N·m");
-  reader.readReal(object, path, "warpRestScale", m.warpRestScale, Range::Positive, "factor");
-  reader.readReal(object, path, "weftRestScale", m.weftRestScale, Range::Positive, "factor");
-  reader.readReal(object, path, "stretchDamping", m.stretchDamping, Range::NonNegative, "N·s/m");
-  reader.readReal(object, path, "shearDamping", m.shearDamping, Range::NonNegative, "N·s/m");
-  reader.readReal(object, path, "bendingDamping", m.bendingDamping, Range::NonNegative, "N·m·s");
-  reader.readReal(object, path, "airDrag", m.airDrag, Range::NonNegative, "N·s/m³");
-  reader.readReal(object, path, "thickness", m.thickness, Range::Positive, "m");
-  reader.readReal(object, path, "friction", m.friction, Range::NonNegative, "Coulomb coefficient");
+  readMaterialValue(reader, object, path, "arealDensity", m.arealDensity, Range::Positive, "kg/m²");
+  readMaterialValue(reader, object, path, "warpStretchStiffness", m.warpStretchStiffness, Range::NonNegative, "N/m");
+  readMaterialValue(reader, object, path, "weftStretchStiffness", m.weftStretchStiffness, Range::NonNegative, "N/m");
+  readMaterialValue(reader, object, path, "shearStiffness", m.shearStiffness, Range::NonNegative, "N/m");
+  readMaterialValue(reader, object, path, "bendingStiffness", m.bendingStiffness, Range::NonNegative, "N·m");
+  readMaterialValue(reader, object, path, "warpRestScale", m.warpRestScale, Range::Positive, "factor");
+  readMaterialValue(reader, object, path, "weftRestScale", m.weftRestScale, Range::Positive, "factor");
+  readMaterialValue(reader, object, path, "stretchDamping", m.stretchDamping, Range::NonNegative, "N·s/m");
+  readMaterialValue(reader, object, path, "shearDamping", m.shearDamping, Range::NonNegative, "N·s/m");
+  readMaterialValue(reader, object, path, "bendingDamping", m.bendingDamping, Range::NonNegative, "N·m·s");
+  readMaterialValue(reader, object, path, "airDrag", m.airDrag, Range::NonNegative, "N·s/m³");
+  readMaterialValue(reader, object, path, "thickness", m.thickness, Range::Positive, "m");
+  readMaterialValue(reader, object, path, "friction", m.friction, Range::NonNegative, "Coulomb coefficient");
   reader.readReal(object, path, "strainLimit", m.strainLimit, Range::NonNegative,
                   "strain l / l_rest - 1 (0 = off)");
 }
@@ -358,12 +395,12 @@ void readSprings(Reader& reader, const Json& object, const std::string& path, Ma
   reader.checkKeys(object, path,
                    {"structuralStiffness", "shearStiffness", "flexionStiffness",
                     "structuralDamping", "shearDamping", "flexionDamping"});
-  reader.readReal(object, path, "structuralStiffness", m.structuralStiffness, Range::NonNegative, "N/m");
-  reader.readReal(object, path, "shearStiffness", m.shearStiffness, Range::NonNegative, "N/m");
-  reader.readReal(object, path, "flexionStiffness", m.flexionStiffness, Range::NonNegative, "N/m");
-  reader.readReal(object, path, "structuralDamping", m.structuralDamping, Range::NonNegative, "N·s/m");
-  reader.readReal(object, path, "shearDamping", m.shearDamping, Range::NonNegative, "N·s/m");
-  reader.readReal(object, path, "flexionDamping", m.flexionDamping, Range::NonNegative, "N·s/m");
+  readMaterialValue(reader, object, path, "structuralStiffness", m.structuralStiffness, Range::NonNegative, "N/m");
+  readMaterialValue(reader, object, path, "shearStiffness", m.shearStiffness, Range::NonNegative, "N/m");
+  readMaterialValue(reader, object, path, "flexionStiffness", m.flexionStiffness, Range::NonNegative, "N/m");
+  readMaterialValue(reader, object, path, "structuralDamping", m.structuralDamping, Range::NonNegative, "N·s/m");
+  readMaterialValue(reader, object, path, "shearDamping", m.shearDamping, Range::NonNegative, "N·s/m");
+  readMaterialValue(reader, object, path, "flexionDamping", m.flexionDamping, Range::NonNegative, "N·s/m");
 }
 
 void readSolver(Reader& reader, const Json& object, const std::string& path, SolverSettings& s) {
@@ -436,10 +473,17 @@ std::optional<GridSettings> readGrid(Reader& reader, const Json& object, const s
   reader.readVec3(object, path, "widthAxis", grid.widthAxis, "", true);
   reader.readVec3(object, path, "heightAxis", grid.heightAxis, "", true);
   if (reader.issueCount() != before) return std::nullopt;
-  if (std::uint64_t(grid.columns) * grid.rows > reader.options().maxVerticesPerCloth) {
+  const std::uint64_t vertices = std::uint64_t(grid.columns) * grid.rows;
+  if (vertices > reader.options().maxVerticesPerCloth) {
     reader.fail(path, std::to_string(grid.columns) + " x " + std::to_string(grid.rows) +
                           " vertices is more than the limit of " +
-                          std::to_string(reader.options().maxVerticesPerCloth) + " per cloth");
+                          std::to_string(reader.options().maxVerticesPerCloth) +
+                          " per cloth; use fewer columns and rows");
+    return std::nullopt;
+  }
+  if (!checkClothMemory(reader, path, std::to_string(grid.columns) + " x " + std::to_string(grid.rows) + " grid",
+                        vertices, 2 * std::uint64_t(grid.columns - 1) * (grid.rows - 1),
+                        "use fewer columns and rows")) {
     return std::nullopt;
   }
   return grid;
@@ -457,7 +501,10 @@ bool readPinSelection(Reader& reader, const Json& pin, const std::string& path,
                                  : "give only one of \"vertices\", \"row\" and \"column\"");
     return false;
   }
-  const Index vertexCount = cloth.model->vertexCount();
+  // A mesh's vertices are numbered as in its file (before welding); readCloth maps them.
+  const MeshImport& import = cloth.model->meshImport();
+  const Index vertexCount = import.modelVertexOfInput.empty() ? cloth.model->vertexCount()
+                                                              : Index(import.modelVertexOfInput.size());
   if (const Json* list = Reader::member(pin, "vertices")) {
     const std::string here = child(path, "vertices");
     if (!list->is_array() || list->empty()) {
@@ -562,16 +609,31 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
     }
   } else if (reader.expectObject(*mesh, child(path, "mesh"), "{\"obj\": \"file.obj\", ...}")) {
     const std::string here = child(path, "mesh");
-    reader.checkKeys(*mesh, here, {"obj", "warpDirection", "requireManifold"});
+    reader.checkKeys(*mesh, here, {"obj", "warpDirection", "requireManifold", "weldVertices",
+                                   "weldTolerance", "fixWinding"});
     MeshSettings settings;
     reader.readVec3(*mesh, here, "warpDirection", settings.warpDirection, "", true);
     reader.readBool(*mesh, here, "requireManifold", settings.requireManifold);
+    reader.readBool(*mesh, here, "weldVertices", settings.weldVertices);
+    if (reader.readReal(*mesh, here, "weldTolerance", settings.weldTolerance, Range::NonNegative,
+                        "fraction of the mesh's bounding-box diagonal") &&
+        !(settings.weldTolerance < 1)) {
+      reader.fail(child(here, "weldTolerance"), "is " + formatNumber(settings.weldTolerance) +
+                                                    "; give a fraction of the mesh's size below 1 "
+                                                    "(default 1e-6)");
+    }
+    reader.readBool(*mesh, here, "fixWinding", settings.fixWinding);
     std::string file;
     if (!Reader::member(*mesh, "obj")) {
       reader.fail(child(here, "obj"), "is missing; give the path of a Wavefront OBJ file");
     } else if (reader.readString(*mesh, here, "obj", file)) {
       cloth.objPath = resolvePath(file, reader.options().baseDirectory);
       std::optional<TriangleMesh> triangles = readMesh(reader, child(here, "obj"), file);
+      if (triangles && !checkClothMemory(reader, child(here, "obj"), "OBJ file '" + cloth.objPath + "'",
+                                         triangles->positions.size(), triangles->indices.size() / 3,
+                                         "simplify the mesh")) {
+        triangles.reset();
+      }
       if (triangles) {
         Result<ClothModel> model = ClothModel::fromMesh(*triangles, settings);
         if (model.ok()) cloth.model = std::make_shared<const ClothModel>(std::move(model).value());
@@ -607,6 +669,21 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
       if (mesh && !grid) reader.fail(here, "pleats are defined on grid cloths only; remove them or use a \"grid\"");
     }
   }
+  // Where the cloth starts (rotated, moved and pleated) must be within kMaxCoordinate, which
+  // World::createCloth and setState demand.
+  if (cloth.model && settings.translation.allFinite()) {
+    Real farthest = 0;
+    for (const Vec3& x : cloth.model->restPositions()) {
+      farthest = std::max(farthest, (settings.rotation * x + settings.translation).cwiseAbs().maxCoeff());
+    }
+    farthest += std::abs(cloth.pleats.amplitude);
+    if (!(farthest <= kMaxCoordinate)) {
+      reader.fail(child(path, Reader::member(object, "translation") ? "translation" : "initialPleats"),
+                  "places the cloth " + formatNumber(farthest) + " m from the origin, beyond the " +
+                      formatNumber(kMaxCoordinate) +
+                      " m a coordinate may have (kMaxCoordinate); keep the scene near the origin");
+    }
+  }
 
   // Pins need the model (indices are checked against it).
   if (const Json* pins = reader.array(object, path, "pins", false, "pin groups [{\"row\": r, \"script\": {...}}]")) {
@@ -622,14 +699,21 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
         PinGroup group;
         if (!readPinSelection(reader, pin, here, cloth, group.vertices)) continue;
         bool unique = true;
-        for (Index vertex : group.vertices) {
-          if (!pinnedAt[vertex].empty()) {
+        const MeshImport& import = cloth.model->meshImport();
+        for (Index& vertex : group.vertices) {
+          const Index model = import.modelVertex(vertex);
+          if (!pinnedAt[model].empty()) {
             reader.fail(here, "vertex " + std::to_string(vertex) + " is already pinned by " +
-                                  pinnedAt[vertex] + "; pin every vertex once");
+                                  pinnedAt[model] +
+                                  (import.modelVertexOfInput.empty()
+                                       ? ""
+                                       : " (coincident vertices are welded into one)") +
+                                  "; pin every vertex once");
             unique = false;
             break;
           }
-          pinnedAt[vertex] = here;
+          pinnedAt[model] = here;
+          vertex = model;
         }
         if (!unique) continue;
         if (const Json* script = Reader::member(pin, "script")) {
@@ -686,7 +770,9 @@ std::optional<ColliderDescription> readCollider(Reader& reader, const Json& obje
   RigidMotion motion;
   reader.readVec3(object, path, "position", motion.pose.position, "m");
   reader.readRotation(object, path, "rotation", motion.pose.rotation);
-  reader.readVec3(object, path, "linearVelocity", motion.linearVelocity, "m/s");
+  if (reader.readVec3(object, path, "linearVelocity", motion.linearVelocity, "m/s")) {
+    checkSpeed(reader, child(path, "linearVelocity"), motion.linearVelocity, "a collider");
+  }
   reader.readVec3(object, path, "angularVelocity", motion.angularVelocity, "rad/s");
   reader.readReal(object, path, "friction", collider.settings.friction, Range::NonNegative, "Coulomb coefficient");
 
@@ -828,7 +914,9 @@ void readWindScript(Reader& reader, const Json& script, SceneDescription& scene)
     reader.checkKeys(key, at, {"time", "wind"});
     WindKeyframe frame = previous;
     reader.readKeyframeTime(key, at, k, previous.time, frame.time);
-    reader.readVec3(key, at, "wind", frame.wind, "m/s");
+    if (reader.readVec3(key, at, "wind", frame.wind, "m/s")) {
+      checkSpeed(reader, child(at, "wind"), frame.wind, "the wind");
+    }
     scene.windKeyframes.push_back(frame);
     previous = frame;
   }
@@ -879,8 +967,16 @@ SceneDescription readScene(Reader& reader, const Json& document) {
   if (const Json* world = Reader::member(document, "world")) {
     if (reader.expectObject(*world, "/world", "gravity and wind")) {
       reader.checkKeys(*world, "/world", {"gravity", "wind", "windScript"});
-      reader.readVec3(*world, "/world", "gravity", scene.gravity, "m/s²");
-      reader.readVec3(*world, "/world", "wind", scene.wind, "m/s");
+      if (reader.readVec3(*world, "/world", "gravity", scene.gravity, "m/s²") &&
+          !(scene.gravity.norm() <= kMaxGravity)) {
+        reader.fail("/world/gravity", "is " + formatNumber(scene.gravity.norm()) + " m/s² long, above " +
+                                          formatNumber(kMaxGravity) +
+                                          " m/s² (kMaxGravity: a second of fall would reach the "
+                                          "speed the engine treats as divergence)");
+      }
+      if (reader.readVec3(*world, "/world", "wind", scene.wind, "m/s")) {
+        checkSpeed(reader, "/world/wind", scene.wind, "the wind");
+      }
       if (const Json* script = Reader::member(*world, "windScript")) readWindScript(reader, *script, scene);
     }
   }
@@ -918,6 +1014,83 @@ SceneDescription readScene(Reader& reader, const Json& document) {
   return scene;
 }
 
+// Builds the document through nlohmann's SAX interface, keeping the JSON Pointer of the value
+// being read, so that a number no double holds ("1e400", which nlohmann refuses as it parses) is
+// reported at its path, like every other bad value.
+struct DocumentBuilder {
+  explicit DocumentBuilder(Json& document) : dom(document, /*allow_exceptions=*/false) {}
+
+  nlohmann::detail::json_sax_dom_parser<Json> dom;
+  std::string errorPath;  // where parsing stopped ("" = the document)
+  std::string message;    // why
+
+  // One open object or array: the key of its current member, or the index of its current element.
+  struct Level {
+    bool array = false;
+    std::string key;
+    std::size_t index = 0;
+  };
+  std::vector<Level> levels;
+
+  std::string path() const {
+    std::string text;
+    for (const Level& level : levels) {
+      text = level.array ? child(text, level.index) : child(text, level.key);
+    }
+    return text;
+  }
+  // A value ended: the enclosing array moves to its next element.
+  bool ended(bool ok) {
+    if (!levels.empty() && levels.back().array) ++levels.back().index;
+    return ok;
+  }
+
+  bool null() { return ended(dom.null()); }
+  bool boolean(bool value) { return ended(dom.boolean(value)); }
+  bool number_integer(Json::number_integer_t value) { return ended(dom.number_integer(value)); }
+  bool number_unsigned(Json::number_unsigned_t value) { return ended(dom.number_unsigned(value)); }
+  bool number_float(Json::number_float_t value, const Json::string_t& text) {
+    return ended(dom.number_float(value, text));
+  }
+  bool string(Json::string_t& value) { return ended(dom.string(value)); }
+  bool binary(Json::binary_t& value) { return ended(dom.binary(value)); }
+  bool start_object(std::size_t size) {
+    levels.push_back({false, {}, 0});
+    return dom.start_object(size);
+  }
+  bool key(Json::string_t& name) {
+    levels.back().key = name;
+    return dom.key(name);
+  }
+  bool end_object() {
+    levels.pop_back();
+    return ended(dom.end_object());
+  }
+  bool start_array(std::size_t size) {
+    levels.push_back({true, {}, 0});
+    return dom.start_array(size);
+  }
+  bool end_array() {
+    levels.pop_back();
+    return ended(dom.end_array());
+  }
+  bool parse_error(std::size_t, const std::string& token, const nlohmann::detail::exception& error) {
+    if (error.id == 406) {
+      // Number overflow: a well-formed number beyond the doubles.
+      errorPath = path();
+      message = "is " + (token.size() > 40 ? token.substr(0, 40) + "..." : token) +
+                ", beyond the largest double (about 1.8e308); give a finite number";
+      return false;
+    }
+    // nlohmann's message names the line and column ("syntax error while parsing value - ...").
+    std::string text = error.what();
+    const std::size_t bracket = text.find("] ");
+    if (bracket != std::string::npos) text = text.substr(bracket + 2);
+    message = "malformed JSON: " + text;
+    return false;
+  }
+};
+
 }  // namespace
 
 std::optional<IntegratorKind> integratorFromName(std::string_view name) {
@@ -939,14 +1112,15 @@ SceneParseOutcome parseSceneText(std::string_view text, const SceneLoadOptions& 
   SceneParseOutcome outcome;
   Reader reader(options, outcome.issues);
   Json document;
+  DocumentBuilder builder(document);
+  bool parsed = false;
   try {
-    document = Json::parse(text.begin(), text.end());
-  } catch (const Json::exception& error) {
-    // nlohmann's message names the line and column ("syntax error while parsing value - ...").
-    std::string message = error.what();
-    const std::size_t bracket = message.find("] ");
-    if (bracket != std::string::npos) message = message.substr(bracket + 2);
-    reader.fail("", "malformed JSON: " + message);
+    parsed = Json::sax_parse(text.begin(), text.end(), &builder);
+  } catch (const std::exception& error) {
+    builder.message = std::string("malformed JSON: ") + error.what();
+  }
+  if (!parsed) {
+    reader.fail(builder.errorPath, builder.message.empty() ? "malformed JSON" : builder.message);
     return outcome;
   }
   try {
@@ -960,23 +1134,14 @@ SceneParseOutcome parseSceneText(std::string_view text, const SceneLoadOptions& 
 }
 
 SceneParseOutcome parseSceneFile(const std::string& path, SceneLoadOptions options) {
-  std::error_code error;
-  if (std::filesystem::is_directory(path, error)) {
+  Result<std::string> text = readInputFile(path, options.maxFileBytes, "scene file");
+  if (!text.ok()) {
     SceneParseOutcome outcome;
-    outcome.issues.push_back({"", "'" + path + "' is a directory; give the path of a scene file (.json)"});
-    return outcome;
-  }
-  std::ifstream file(path, std::ios::binary);
-  std::ostringstream text;
-  if (file) text << file.rdbuf();
-  if (!file) {
-    SceneParseOutcome outcome;
-    outcome.issues.push_back({"", "cannot read scene file '" + path +
-                                      "'; check the path and the permissions"});
+    outcome.issues.push_back({"", text.error().message});
     return outcome;
   }
   options.baseDirectory = std::filesystem::path(path).parent_path().string();
-  SceneParseOutcome outcome = parseSceneText(text.str(), options);
+  SceneParseOutcome outcome = parseSceneText(text.value(), options);
   if (outcome.scene && outcome.scene->name.empty()) {
     outcome.scene->name = std::filesystem::path(path).stem().string();
   }

@@ -95,7 +95,9 @@ Result<ScriptedScene> ScriptedScene::create(SceneDescription description,
   if (!(description.frameDt > 0 && std::isfinite(description.frameDt))) {
     return Error{"/run/frameDt: must be a positive number of seconds"};
   }
-  scene.m_world = std::make_unique<World>(worldSettings);
+  Result<World> world = World::create(worldSettings);
+  if (!world.ok()) return Error{"scene settings: " + world.error().message};
+  scene.m_world = std::make_unique<World>(std::move(world).value());
 
   for (std::size_t k = 0; k < description.cloths.size(); ++k) {
     const ClothDescription& cloth = description.cloths[k];

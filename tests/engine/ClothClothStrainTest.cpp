@@ -71,6 +71,7 @@ void makePadOnSheet(PadOnSheet& scene, const PadOnSheetOptions& options = {}) {
 
 struct Outcome {
   Real sheetStrain = 0, padStrain = 0;  // largest over the frames, measured after the step
+  Real padHeight = 0;  // m, the pad's mean vertex height at the end
 };
 
 // Steps `frames` frames, asserting in each a finite state and no intersection within or between
@@ -78,8 +79,9 @@ struct Outcome {
 Outcome run(PadOnSheet& scene, int frames) {
   Outcome outcome;
   IntersectionCounter counter(scene.world, {scene.sheet, scene.pad});
+  test::StepHealth health;
   for (int frame = 0; frame < frames; ++frame) {
-    (void)scene.world.step(kFrame);
+    health(scene.world.step(kFrame));
     const Real sheet = maxStrain(scene.world, scene.sheet, *scene.sheetModel);
     const Real pad = maxStrain(scene.world, scene.pad, *scene.padModel);
     EXPECT_TRUE(std::isfinite(sheet) && std::isfinite(pad)) << "frame " << frame;
@@ -91,14 +93,17 @@ Outcome run(PadOnSheet& scene, int frames) {
       EXPECT_EQ(scene.world.stats().maxStrain, std::max(sheet, pad)) << "frame " << frame;
     }
   }
+  health.expectHealthy("pad on sheet");
   EXPECT_GT(scene.world.stats().clothContacts, 0u);
   const std::span<const Vec3> sheet = scene.world.positions(scene.sheet).value();
   Real lowestSheet = std::numeric_limits<Real>::infinity();
   for (const Vec3& x : sheet) lowestSheet = std::min(lowestSheet, x.y());
-  for (const Vec3& x : scene.world.positions(scene.pad).value()) {
+  const std::span<const Vec3> pad = scene.world.positions(scene.pad).value();
+  for (const Vec3& x : pad) {
     EXPECT_GT(x.y(), lowestSheet);
     EXPECT_LT(x.y(), 1.0);
   }
+  outcome.padHeight = test::meanVertexHeight(pad);
   return outcome;
 }
 
@@ -147,12 +152,19 @@ TEST(ClothClothStrain, EachClothKeepsItsOwnLimit) {
 
 TEST(ClothClothStrain, APadWithoutALimitIsLiftedByTheSheet) {
   // Only the sheet has a limiter: the pad has no edges in the pass's limiter, but its vertices
-  // move with the held pairs, so the sheet can still lift it.
-  PadOnSheet scene;
+  // move with the held pairs, so the sheet can still lift it: the pad rests where the sheet at its
+  // limit holds it, as high as the same pad with a limit of its own (within the contact
+  // thickness), not sunk into a sheet stretched under it.
+  PadOnSheet scene, limited;
   makePadOnSheet(scene, {.padLimit = 0});
+  makePadOnSheet(limited);
   const Outcome outcome = run(scene, 120);
-  std::printf("[strain] pad without a limit: sheet max strain %.4f\n", outcome.sheetStrain);
+  const Outcome withLimit = run(limited, 120);
+  std::printf("[strain] pad without a limit: sheet max strain %.4f; pad's mean height %.4f m "
+              "(%.4f with its own limit)\n", outcome.sheetStrain, outcome.padHeight,
+              withLimit.padHeight);
   EXPECT_LE(outcome.sheetStrain, 0.10 + 0.01);
+  EXPECT_NEAR(outcome.padHeight, withLimit.padHeight, cottonFabric().thickness);
 }
 
 TEST(ClothClothStrain, ADensePadOnASheetOnTheFloorStaysOutOfTheFloor) {

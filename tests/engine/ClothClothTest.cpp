@@ -11,6 +11,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 namespace weft {
 namespace {
@@ -46,17 +48,19 @@ void makeLayers(Layers& layers, bool sphere, ClothSettings topSettings = {},
 }
 
 // Steps `frames` frames, asserting in each that nothing intersects and nothing is inside.
+// No frame may be rolled back or retried with a smaller step.
 void stepChecked(Layers& layers, int frames) {
   IntersectionCounter counter(layers.world, {layers.bottom, layers.top});
+  test::StepHealth health;
   for (int frame = 0; frame < frames; ++frame) {
-    const StepStatus status = layers.world.step(kFrame);
-    ASSERT_FALSE(hasFlag(status, StepStatus::RolledBack)) << "frame " << frame;
+    health(layers.world.step(kFrame));
     ASSERT_EQ(counter.count(layers.world), 0u) << "intersecting triangle pairs, frame " << frame;
     for (ClothId cloth : {layers.bottom, layers.top}) {
       ASSERT_GE(closestApproach(layers.world, cloth, layers.collider), 0.0)
           << "a vertex is inside the collider, frame " << frame;
     }
   }
+  health.expectHealthy("layers");
 }
 
 TEST(ClothCloth, TwoLayersPileUpOnTheFloor) {
@@ -98,20 +102,23 @@ TEST(ClothCloth, ALayerFallingOntoALayerOnASphereDoesNotTear) {
   // cloth–cloth impulses; when such held corners shared a triangle with a free one, the free
   // corner took the whole impulse through its small barycentric weight (7.7 m/s for a relative
   // change of 1.6 m/s) and the silk tore to a strain of 1.8 in one frame, 300 later.
-  ClothSettings silk;
+  ClothSettings silk, cotton;
   silk.material = silkFabric();
+  cotton.material = cottonFabric();
   Layers layers;
-  makeLayers(layers, true, silk);
+  makeLayers(layers, true, silk, cotton);
   Real worst = 0;
+  test::StepHealth health;
   for (int frame = 0; frame < 60; ++frame) {
-    const StepStatus status = layers.world.step(kFrame);
-    ASSERT_FALSE(hasFlag(status, StepStatus::RetriedWithSmallerStep)) << "frame " << frame;
+    health(layers.world.step(kFrame));
     worst = std::max(worst, layers.world.stats().maxStrain);
   }
   EXPECT_GT(layers.world.stats().clothContacts, 0u);
-  // The drop alone (a layer on the sphere, without the other) stretches the silk to about 0.3
-  // where it folds over the sphere's top.
-  EXPECT_LT(worst, 0.6);
+  health.expectHealthy("silk on cotton on a sphere");
+  // The limit + 0.01: silk's and cotton's limits are both 0.10, and StepStats::maxStrain is the
+  // largest strain over both cloths at the end of each frame.
+  std::printf("[cloth-cloth] silk falling on cotton on a sphere: max strain %.4f\n", worst);
+  EXPECT_LE(worst, silkFabric().strainLimit + 0.01);
 }
 
 TEST(ClothCloth, WithoutTheSwitchTheLayersPassThroughEachOther) {
@@ -123,10 +130,12 @@ TEST(ClothCloth, WithoutTheSwitchTheLayersPassThroughEachOther) {
   makeLayers(layers, false, apart);
   IntersectionCounter counter(layers.world, {layers.bottom, layers.top});
   Index worst = 0;
+  test::StepHealth health;
   for (int frame = 0; frame < 90; ++frame) {
-    layers.world.step(kFrame);
+    health(layers.world.step(kFrame));
     worst = std::max(worst, counter.count(layers.world));
   }
+  health.expectHealthy("layers passing through each other");
   EXPECT_GT(worst, 0u);
   EXPECT_EQ(layers.world.stats().clothContacts, 0u);
 }
@@ -156,10 +165,12 @@ TEST(ClothCloth, AFastLayerDoesNotTunnelThroughAPinnedSheet) {
   const std::span<const Vec3> x = world.positions(layer).value();
   ASSERT_TRUE(world.setState(layer, Vec3Array(x.begin(), x.end()), Vec3Array(x.size(), Vec3(0, -30, 0))).ok());
   IntersectionCounter counter(world, {sheet, layer});
+  test::StepHealth health;
   for (int frame = 0; frame < 30; ++frame) {
-    world.step(kFrame);
+    health(world.step(kFrame));
     ASSERT_EQ(counter.count(world), 0u) << "frame " << frame;
   }
+  health.expectHealthy("fast layer");
   // Every vertex of the layer is still above the sheet's middle.
   const Real sheetMiddle = world.positions(sheet).value()[kCentre].y();
   for (const Vec3& p : world.positions(layer).value()) EXPECT_GT(p.y(), sheetMiddle - 0.05);
@@ -176,10 +187,11 @@ TEST(ClothCloth, ThreeLayersStayApartWhenOneIsRemovedAndAnotherAdded) {
     settings.rotation = turnAboutY(0.4 * layer);
     cloths.push_back(world.createCloth(horizontalSquare(9, 0.4, 0.05 + 0.05 * layer), settings).value());
   }
+  test::StepHealth health;
   auto stepAll = [&](int frames) {
     IntersectionCounter counter(world, cloths);
     for (int frame = 0; frame < frames; ++frame) {
-      world.step(kFrame);
+      health(world.step(kFrame));
       ASSERT_EQ(counter.count(world), 0u) << "frame " << frame;
       for (ClothId cloth : cloths) ASSERT_GE(closestApproach(world, cloth, floor), 0.0);
     }
@@ -191,6 +203,7 @@ TEST(ClothCloth, ThreeLayersStayApartWhenOneIsRemovedAndAnotherAdded) {
   cloths.push_back(world.createCloth(horizontalSquare(9, 0.4, 0.15), settings).value());
   stepAll(45);
   EXPECT_GT(world.stats().clothContacts, 0u);
+  health.expectHealthy("three layers");
 }
 
 TEST(ClothCloth, IsBitwiseIdenticalOnOneAndTwoThreads) {
@@ -199,11 +212,13 @@ TEST(ClothCloth, IsBitwiseIdenticalOnOneAndTwoThreads) {
     TaskSystem tasks(TaskSystemSettings{threads});
     Layers layers{World(WorldSettings{.taskSystem = &tasks}), {}, {}, {}};
     makeLayers(layers, false);
+    test::StepHealth health;
     for (int frame = 0; frame < 45; ++frame) {
-      layers.world.step(kFrame);
+      health(layers.world.step(kFrame));
       hashes[threads - 1].push_back(layers.world.stateHash());
     }
     EXPECT_GT(layers.world.stats().clothContacts, 0u);
+    health.expectHealthy("layers on " + std::to_string(threads) + " threads");
   }
   EXPECT_EQ(hashes[0], hashes[1]);
 }

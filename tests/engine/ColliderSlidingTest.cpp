@@ -1,6 +1,8 @@
 // A collider contact may only push: a sphere that pushes into a hanging sheet and then
 // withdraws faster than the sheet falls back must leave it behind, not drag it along, and a
 // floor must let go of cloth pulled up off it.
+#include "ContactTestSupport.h"
+
 #include <weft/collision/Plane.h>
 #include <weft/collision/Sphere.h>
 #include <weft/engine/World.h>
@@ -8,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cstdio>
 
 namespace weft {
 namespace {
@@ -38,7 +41,9 @@ SheetAndSphere pushedSheet() {
   motion.pose.position = {0.0, 0.85, -0.35};
   motion.linearVelocity = {0.0, 0.0, 0.8};
   scene.sphere = scene.world->addCollider(Sphere::create(0.15, motion).value()).value();
-  for (int k = 0; k < 45; ++k) scene.world->step(1.0 / 60.0);  // centre reaches z = +0.25
+  test::StepHealth health;
+  for (int k = 0; k < 45; ++k) health(scene.world->step(1.0 / 60.0));  // centre reaches z = +0.25
+  health.expectHealthy("sphere pushing the sheet");
   return scene;
 }
 
@@ -60,14 +65,16 @@ TEST(ColliderSliding, AWithdrawingSphereLeavesTheSheetAsIfItHadVanished) {
   ASSERT_TRUE(withdrawn.world->setColliderMotion(withdrawn.sphere, motion).ok());
   ASSERT_TRUE(vanished.world->destroyCollider(vanished.sphere).ok());
   Real largestGap = 0;
+  test::StepHealth health;
   for (int k = 0; k < 20; ++k) {
-    withdrawn.world->step(1.0 / 60.0);
-    vanished.world->step(1.0 / 60.0);
+    health(withdrawn.world->step(1.0 / 60.0));
+    health(vanished.world->step(1.0 / 60.0));
     const std::span<const Vec3> a = withdrawn.world->positions(withdrawn.cloth).value();
     const std::span<const Vec3> b = vanished.world->positions(vanished.cloth).value();
     for (std::size_t i = 0; i < a.size(); ++i) largestGap = std::max(largestGap, (a[i] - b[i]).norm());
   }
   EXPECT_LT(largestGap, 0.01) << "m: the withdrawing sphere dragged the sheet";
+  health.expectHealthy("withdrawing sphere");
 }
 
 TEST(ColliderSliding, ClothLyingOnTheFloorLiftsOffWhenPulledUp) {
@@ -90,18 +97,30 @@ TEST(ColliderSliding, ClothLyingOnTheFloorLiftsOffWhenPulledUp) {
   ASSERT_TRUE(world.addCollider(Plane::create({0.0, 1.0, 0.0}).value()).ok());
   const ClothId cloth = world.createCloth(model, settings).value();
   // Let gravity press it onto the floor first.
-  for (int k = 0; k < 30; ++k) world.step(1.0 / 60.0);
+  test::StepHealth health;
+  Real maxStrain = 0;
+  for (int k = 0; k < 30; ++k) health(world.step(1.0 / 60.0));
   std::vector<Vec3> targets = world.pinTargets(cloth).value();
   for (int k = 0; k < 30; ++k) {
     for (Vec3& target : targets) target.y() += 0.05;
     ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
-    world.step(1.0 / 60.0);
+    health(world.step(1.0 / 60.0));
+    maxStrain = std::max(maxStrain, world.stats().maxStrain);
   }
+  health.expectHealthy("sheet pulled off the floor");
   const std::span<const Vec3> x = world.positions(cloth).value();
   // The row next to the lifted one hangs below it by about one spacing, not on the floor.
   const Index nextRow = (kRows - 2) * kColumns + kColumns / 2;
   EXPECT_GT(x[nextRow].y(), 1.5 - 2 * 0.05);
-  EXPECT_LT(world.stats().maxStrain, 0.1);
+  // Off the floor and carried up at a steady 3 m/s, the sheet hangs from its pinned edge: its
+  // strain is at most twice the static strain under that edge, ρ_A g H / k. (The default
+  // material has no strain limit, and the yank's first frames, pins stepping one edge length a
+  // frame from rest, stretch it as much with the floor as without it: not bounded here.)
+  const ClothMaterial material;
+  const Real hanging = 2 * material.arealDensity * 9.81 * grid.height / material.weftStretchStiffness;
+  std::printf("[sliding] sheet pulled off the floor: max strain %.4f over the lift, %.4f at its end "
+              "(bound %.4f)\n", maxStrain, world.stats().maxStrain, hanging);
+  EXPECT_LT(world.stats().maxStrain, hanging);
 }
 
 }  // namespace

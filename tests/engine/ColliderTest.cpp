@@ -21,10 +21,10 @@ std::shared_ptr<const ClothModel> square(Index vertices, Real size, Real height)
 using test::closestApproach;
 
 // Steps one frame and checks the contracts of every frame: no vertex inside the collider, no
-// intersecting triangle pair.
+// intersecting triangle pair; `health` records rollbacks and retries.
 void stepChecked(World& world, ClothId cloth, ColliderId collider, test::IntersectionCounter& counter,
-                 int frame) {
-  world.step(kFrame);
+                 test::StepHealth& health, int frame) {
+  health(world.step(kFrame));
   ASSERT_GE(closestApproach(world, cloth, collider), 0.0) << "a vertex is inside, frame " << frame;
   ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
 }
@@ -34,12 +34,13 @@ TEST(Collider, ClothDropsOntoASphereAndRestsOnIt) {
   const ColliderId sphere = world.addCollider(Sphere::create(0.3).value()).value();
   const ClothId cloth = world.createCloth(square(21, 1.2, 0.5), ClothSettings{}).value();
   test::IntersectionCounter counter(world, {cloth});
+  test::StepHealth health;
   const Real top = 0.3 + ClothMaterial{}.thickness;  // m, where the centre rests
   Real lateEnergy = 0;  // J, summed over frames 120..149
   bool landed = false;  // the centre has reached the top
   int leftTheTop = -1;  // the first frame after that with the centre more than 1 cm off it
   for (int frame = 0; frame < 300; ++frame) {
-    stepChecked(world, cloth, sphere, counter, frame);
+    stepChecked(world, cloth, sphere, counter, health, frame);
     ASSERT_EQ(world.stats().status, StepStatus::Ok) << "frame " << frame;
     const std::span<const Vec3> x = world.positions(cloth).value();
     const bool onTop = std::abs(x[10 * 21 + 10].y() - top) <= 0.01;
@@ -72,7 +73,9 @@ TEST(Collider, ClothFallsOntoTheFloorAndStaysAboveIt) {
   const ColliderId floor = world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
   const ClothId cloth = world.createCloth(square(11, 0.5, 0.2), ClothSettings{}).value();
   test::IntersectionCounter counter(world, {cloth});
-  for (int frame = 0; frame < 90; ++frame) stepChecked(world, cloth, floor, counter, frame);
+  test::StepHealth health;
+  for (int frame = 0; frame < 90; ++frame) stepChecked(world, cloth, floor, counter, health, frame);
+  health.expectHealthy("cloth on the floor");
   for (const Vec3& x : world.positions(cloth).value()) EXPECT_NEAR(x.y(), 0.003, 1e-3);
 }
 
@@ -98,7 +101,9 @@ TEST(Collider, FrictionOfASpinningSphereDragsTheCloth) {
     settings.material.friction = 0.4;
     const ClothId cloth = world.createCloth(square(21, 1.0, 0.35), settings).value();
     test::IntersectionCounter counter(world, {cloth});
-    for (int frame = 0; frame < 120; ++frame) stepChecked(world, cloth, sphere, counter, frame);
+    test::StepHealth health;
+    for (int frame = 0; frame < 120; ++frame) stepChecked(world, cloth, sphere, counter, health, frame);
+    health.expectHealthy("spinning sphere");
     spins[withFriction] = spin(world, cloth) / world.velocities(cloth).value().size();
   }
   // The sphere's surface moves with ω × r, whose angular momentum about +y is positive.
@@ -128,7 +133,9 @@ TEST(Collider, FastProjectileDoesNotTunnelThroughAPinnedSheet) {
   projectile.linearVelocity = Vec3(0, 0, 50);
   const ColliderId sphere = world.addCollider(Sphere::create(0.1, projectile).value()).value();
   test::IntersectionCounter counter(world, {cloth});
-  for (int frame = 0; frame < 3; ++frame) stepChecked(world, cloth, sphere, counter, frame);
+  test::StepHealth health;
+  for (int frame = 0; frame < 3; ++frame) stepChecked(world, cloth, sphere, counter, health, frame);
+  health.expectHealthy("fast projectile");
   // The sphere is now 1.5 m past the sheet's plane; the sheet's middle went with it.
   const Real sphereZ = motion(*world.collider(sphere).value()).pose.position.z();
   EXPECT_GT(sphereZ, 1.4);

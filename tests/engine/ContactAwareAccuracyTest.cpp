@@ -44,9 +44,10 @@ TEST(ContactAwareAccuracy, AClothJammedInSelfContactSolvesTightly) {
   CornerDrop tight(defaults), loose(untightened);
   Real tightWorst = 0, looseWorst = 0;
   Index jammedFrames = 0;
+  test::StepHealth tightHealth, looseHealth;
   for (int frame = 0; frame < 150; ++frame) {
-    tight.world.step(kFrame);
-    loose.world.step(kFrame);
+    tightHealth(tight.world.step(kFrame));
+    looseHealth(loose.world.step(kFrame));
     // A frame after one whose self passes found many contacts per vertex is jammed (the stats
     // count every pass of the frame, at least the first one's contacts).
     const StepStats& stats = tight.world.stats();
@@ -60,6 +61,8 @@ TEST(ContactAwareAccuracy, AClothJammedInSelfContactSolvesTightly) {
   std::printf("[contact-aware] corner drop, %d jammed frames from frame 60: worst residual %.3g "
               "tightened, %.3g not\n",
               int(jammedFrames), tightWorst, looseWorst);
+  tightHealth.expectHealthy("corner drop, tightened");
+  looseHealth.expectHealthy("corner drop, not tightened");
   ASSERT_GT(jammedFrames, 20);  // the pile forms and stays in self-contact
   EXPECT_LE(tightWorst, defaults.tightCgTolerance);
   EXPECT_GT(looseWorst, 10 * defaults.tightCgTolerance);

@@ -1,6 +1,6 @@
-// Checks shared by the contact scenes (ClothClothTest, CollisionScenesTest): intersecting
-// triangle pairs within and between cloths (the exact triangle–triangle test) and the deepest
-// vertex inside a collider.
+// Checks shared by the contact scenes (ClothClothTest, CollisionScenesTest, ...): intersecting
+// triangle pairs within and between cloths (the exact triangle–triangle test), the deepest
+// vertex inside a collider, and the health monitor's rollbacks and retries.
 #pragma once
 
 #include <weft/collision/Proximity.h>
@@ -15,6 +15,7 @@
 
 #include <limits>
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace weft::test {
@@ -82,6 +83,36 @@ class IntersectionCounter {
   std::vector<ClothId> m_cloths;
   std::unique_ptr<SelfIntersectionCounter> m_counter;
   Vec3Array m_positions;
+};
+
+/// The health monitor's interventions over a run, from World::step()'s flags. A rolled-back
+/// frame (StepStatus::RolledBack) ends where it started, so a scene the monitor kept freezing
+/// would pass every other check: contact scenes assert none. A frame retried with a smaller step
+/// (StepStatus::RetriedWithSmallerStep) is allowed only up to a bound the scene declares, with
+/// its reason.
+class StepHealth {
+ public:
+  /// Records one frame's flags and returns them.
+  StepStatus operator()(StepStatus status) {
+    const int frame = m_frames++;  // counted from 0, as the scenes' loops do
+    if (hasFlag(status, StepStatus::RolledBack) && m_rolledBack++ == 0) m_firstRolledBack = frame;
+    if (hasFlag(status, StepStatus::RetriedWithSmallerStep) && m_retried++ == 0) m_firstRetried = frame;
+    return status;
+  }
+  int rolledBack() const { return m_rolledBack; }
+  int retried() const { return m_retried; }
+
+  /// No frame rolled back; at most `allowedRetries` retried, for the reason `why`.
+  void expectHealthy(const std::string& scene, int allowedRetries = 0, const char* why = nullptr) const {
+    EXPECT_EQ(m_rolledBack, 0) << scene << ": " << m_rolledBack << " of " << m_frames
+                               << " frames rolled back (the first: frame " << m_firstRolledBack << ")";
+    EXPECT_LE(m_retried, allowedRetries)
+        << scene << ": " << m_retried << " of " << m_frames << " frames retried with a smaller "
+        << "step (the first: frame " << m_firstRetried << ")" << (why ? std::string("; ") + why : "");
+  }
+
+ private:
+  int m_frames = 0, m_rolledBack = 0, m_retried = 0, m_firstRolledBack = -1, m_firstRetried = -1;
 };
 
 /// Smallest signed distance (m) of any vertex of `cloth` to the collider: negative = inside.

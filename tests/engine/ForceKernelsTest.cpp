@@ -815,7 +815,6 @@ TEST(ForceKernels, DegenerateInputGivesFiniteResults) {
   triangle("warp collapsed", p, p, p + Vec3(0, 0.05, 0));
   {
     const StretchConditions stretch = stretchConditions(p, p, p, rest, 1, 1, true);
-    EXPECT_EQ(stretch.warp.gradient, Condition<3>::Gradient::Zero());
     EXPECT_NEAR(stretch.warp.value, -std::sqrt(rest.area), 1e-15);
   }
 
@@ -842,6 +841,39 @@ TEST(ForceKernels, DegenerateInputGivesFiniteResults) {
   expectFinite("zero-length spring collapsed", springCondition(p, p, 0, true));
   expectFinite("zero-length spring, tiny extension",
                springCondition(p, p + Vec3(1e-300, 0, 0), 0, true));
+}
+
+TEST(ForceKernels, ACollapsedStretchFibreIsPushedOpenAcrossTheOther) {
+  // A fibre collapsed to a point has no direction; the kernel gives it one (BaraffWitkin.h), the
+  // same for every triangle, so that a cloth collapsed onto a point or a line opens again.
+  const TriangleRest rest = makeTriangleRest({0, 1, 2}, Vec2(0, 0), Vec2(0.05, 0), Vec2(0, 0.05));
+  const Real sqrtArea = std::sqrt(rest.area);
+  const auto expectAlong = [&](const Condition<3>& condition, const std::array<Real, 3>& weights,
+                               const Vec3& direction, const std::string& name) {
+    for (int i = 0; i < 3; ++i) {
+      EXPECT_LE((condition.gradient.segment<3>(3 * i) - sqrtArea * weights[i] * direction).norm(),
+                1e-12) << name << ", vertex " << i;
+    }
+    EXPECT_EQ(condition.hessian, Condition<3>::Hessian::Zero()) << name;
+  };
+  const Vec3 p(0.3, -0.2, 0.1);
+  // On one point: warp along x, weft along y.
+  const StretchConditions point = stretchConditions(p, p, p, rest, 1, 1, true);
+  expectAlong(point.warp, rest.warpWeights, Vec3::UnitX(), "point, warp");
+  expectAlong(point.weft, rest.weftWeights, Vec3::UnitY(), "point, weft");
+  // On a line along z (the warp fibre intact): the weft across it, along the world axis least
+  // aligned with it (x).
+  const StretchConditions line = stretchConditions(p, p + Vec3(0, 0, 0.05), p, rest, 1, 1, true);
+  expectAlong(line.weft, rest.weftWeights, Vec3::UnitX(), "line, weft");
+  EXPECT_GT(line.warp.gradient.segment<3>(3).z(), 0.0);  // the intact fibre as before
+  // The force −k C ∇C (C < 0) opens the collapsed fibre: a small step along it gives |w| > 0 and
+  // lowers the energy k/2 C².
+  const Condition<3>& weft = line.weft;
+  std::array<Vec3, 3> x{p, p + Vec3(0, 0, 0.05), p};
+  for (int i = 0; i < 3; ++i) x[i] -= 1e-4 * weft.value * weft.gradient.segment<3>(3 * i);
+  const StretchConditions opened = stretchConditions(x[0], x[1], x[2], rest, 1, 1, false);
+  EXPECT_GT(opened.weft.value, weft.value);
+  EXPECT_LT(opened.weft.value * opened.weft.value, weft.value * weft.value);
 }
 
 }  // namespace

@@ -50,7 +50,9 @@ Real clothSlideOnIncline(Real degrees, Real friction, int frames) {
   settings.translation = settings.material.thickness * normal;
   const ClothId cloth = world.createCloth(test::horizontalSquare(11, 0.3, 0.0), settings).value();
   const Vec3 start = world.positions(cloth).value()[60];
-  for (int frame = 0; frame < frames; ++frame) world.step(1.0 / 60);
+  test::StepHealth health;
+  for (int frame = 0; frame < frames; ++frame) health(world.step(1.0 / 60));
+  health.expectHealthy("cloth on an incline");
   return (world.positions(cloth).value()[60] - start).norm();
 }
 

@@ -1,12 +1,17 @@
 // World::step() allocates nothing once a cloth has taken its first step (DESIGN.md §7): the
 // matrix pattern, solver scratch and integrator buffers are all sized up front or on first use.
 // Counted by replacing the global operator new for this test binary; counting is switched on
-// only around the steps under test.
+// only around the steps under test. The replacement also keeps the heap's live and peak bytes
+// for the whole binary (HeapCounter.h).
 #include <weft/engine/FabricPresets.h>
 #include <weft/engine/World.h>
 #include <weft/scenes/Curtain.h>
 
 #include <gtest/gtest.h>
+
+#include "HeapCounter.h"
+
+#include <malloc.h>
 
 #include <atomic>
 #include <cstdlib>
@@ -15,30 +20,53 @@
 namespace {
 std::atomic<bool> g_counting{false};
 std::atomic<long> g_allocations{0};
+// Heap bytes live and their peak (HeapCounter.h), from the allocator's usable sizes.
+std::atomic<long long> g_liveBytes{0};
+std::atomic<long long> g_peakBytes{0};
+
+void* noteNew(void* memory) {
+  if (!memory) return memory;
+  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
+  const long long size = static_cast<long long>(malloc_usable_size(memory));
+  const long long live = g_liveBytes.fetch_add(size, std::memory_order_relaxed) + size;
+  long long peak = g_peakBytes.load(std::memory_order_relaxed);
+  while (live > peak && !g_peakBytes.compare_exchange_weak(peak, live, std::memory_order_relaxed)) {
+  }
+  return memory;
+}
+// Not inlined: GCC would then see free() on a pointer from operator new and warn.
+[[gnu::noinline]] void freeNoted(void* memory) {
+  if (memory) g_liveBytes.fetch_sub(static_cast<long long>(malloc_usable_size(memory)), std::memory_order_relaxed);
+  std::free(memory);
+}
+void* alignedAllocate(std::size_t size, std::align_val_t alignment) {
+  const std::size_t align = static_cast<std::size_t>(alignment);
+  return std::aligned_alloc(align, (size + align - 1) / align * align);
+}
 }  // namespace
 
+namespace weft::test {
+long long heapLiveBytes() { return g_liveBytes.load(); }
+long long heapPeakBytes() { return g_peakBytes.load(); }
+void resetHeapPeak() { g_peakBytes.store(g_liveBytes.load()); }
+}  // namespace weft::test
+
 void* operator new(std::size_t size) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (void* memory = std::malloc(size == 0 ? 1 : size)) return memory;
+  if (void* memory = noteNew(std::malloc(size == 0 ? 1 : size))) return memory;
   throw std::bad_alloc();
 }
 void* operator new(std::size_t size, std::align_val_t alignment) {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  const std::size_t align = static_cast<std::size_t>(alignment);
-  if (void* memory = std::aligned_alloc(align, (size + align - 1) / align * align)) return memory;
+  if (void* memory = noteNew(alignedAllocate(size, alignment))) return memory;
   throw std::bad_alloc();
 }
 // Every other form of new is replaced too, so that no block from the library's allocator reaches
 // the free() below (std::stable_sort's nothrow temporary buffer did, and AddressSanitizer reports
 // that as an alloc-dealloc mismatch).
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  return std::malloc(size == 0 ? 1 : size);
+  return noteNew(std::malloc(size == 0 ? 1 : size));
 }
 void* operator new(std::size_t size, std::align_val_t alignment, const std::nothrow_t&) noexcept {
-  if (g_counting.load(std::memory_order_relaxed)) g_allocations.fetch_add(1, std::memory_order_relaxed);
-  const std::size_t align = static_cast<std::size_t>(alignment);
-  return std::aligned_alloc(align, (size + align - 1) / align * align);
+  return noteNew(alignedAllocate(size, alignment));
 }
 void* operator new[](std::size_t size) { return operator new(size); }
 void* operator new[](std::size_t size, std::align_val_t alignment) { return operator new(size, alignment); }
@@ -46,18 +74,18 @@ void* operator new[](std::size_t size, const std::nothrow_t& tag) noexcept { ret
 void* operator new[](std::size_t size, std::align_val_t alignment, const std::nothrow_t& tag) noexcept {
   return operator new(size, alignment, tag);
 }
-void operator delete(void* memory, const std::nothrow_t&) noexcept { std::free(memory); }
-void operator delete(void* memory, std::align_val_t, const std::nothrow_t&) noexcept { std::free(memory); }
-void operator delete[](void* memory) noexcept { std::free(memory); }
-void operator delete[](void* memory, std::size_t) noexcept { std::free(memory); }
-void operator delete[](void* memory, std::align_val_t) noexcept { std::free(memory); }
-void operator delete[](void* memory, std::size_t, std::align_val_t) noexcept { std::free(memory); }
-void operator delete[](void* memory, const std::nothrow_t&) noexcept { std::free(memory); }
-void operator delete[](void* memory, std::align_val_t, const std::nothrow_t&) noexcept { std::free(memory); }
-void operator delete(void* memory) noexcept { std::free(memory); }
-void operator delete(void* memory, std::size_t) noexcept { std::free(memory); }
-void operator delete(void* memory, std::align_val_t) noexcept { std::free(memory); }
-void operator delete(void* memory, std::size_t, std::align_val_t) noexcept { std::free(memory); }
+void operator delete(void* memory, const std::nothrow_t&) noexcept { freeNoted(memory); }
+void operator delete(void* memory, std::align_val_t, const std::nothrow_t&) noexcept { freeNoted(memory); }
+void operator delete[](void* memory) noexcept { freeNoted(memory); }
+void operator delete[](void* memory, std::size_t) noexcept { freeNoted(memory); }
+void operator delete[](void* memory, std::align_val_t) noexcept { freeNoted(memory); }
+void operator delete[](void* memory, std::size_t, std::align_val_t) noexcept { freeNoted(memory); }
+void operator delete[](void* memory, const std::nothrow_t&) noexcept { freeNoted(memory); }
+void operator delete[](void* memory, std::align_val_t, const std::nothrow_t&) noexcept { freeNoted(memory); }
+void operator delete(void* memory) noexcept { freeNoted(memory); }
+void operator delete(void* memory, std::size_t) noexcept { freeNoted(memory); }
+void operator delete(void* memory, std::align_val_t) noexcept { freeNoted(memory); }
+void operator delete(void* memory, std::size_t, std::align_val_t) noexcept { freeNoted(memory); }
 
 namespace weft {
 namespace {

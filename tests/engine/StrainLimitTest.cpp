@@ -56,6 +56,7 @@ HangingRun hangWeight(Real strainLimit, int frames = 120) {
     EXPECT_EQ(world.stats().strainLimitEdgesOver, 0u) << "frame " << frame;
     run.hashes.push_back(world.stateHash());
   }
+  health.expectHealthy("spinning sphere");
   return run;
 }
 
@@ -127,8 +128,9 @@ SpinRun dropOnSpinningSphere(int threads) {
   settings.selfCollision = false;  // the collider path alone, and a fast test
   const ClothId cloth = world.createCloth(test::horizontalSquare(15, 0.7, 0.25), settings).value();
   SpinRun run;
+  test::StepHealth health;
   for (int frame = 0; frame < 90; ++frame) {
-    world.step(kStep);
+    health(world.step(kStep));
     run.maxStrain = std::max(run.maxStrain, world.stats().maxStrain);
     const Shape* shape = world.collider(sphere).value();
     for (const Vec3& x : world.positions(cloth).value()) {
@@ -136,6 +138,7 @@ SpinRun dropOnSpinningSphere(int threads) {
     }
     run.hashes.push_back(world.stateHash());
   }
+  health.expectHealthy("spinning sphere");
   return run;
 }
 
@@ -170,13 +173,14 @@ TEST(StrainLimitWorld, ASpherePushedIntoAHangingSheetWithLargeStepsStaysWithinTh
   pusher.linearVelocity = Vec3(0, 0, 0.6);  // 0.42 m in 0.7 s: its front ends 0.27 m past the sheet
   const ColliderId sphere = world.addCollider(Sphere::create(0.15, pusher).value()).value();
   Real maxStrain = 0;
+  test::StepHealth health;
   for (int frame = 0; frame < 30; ++frame) {
     if (frame == 21) {
       RigidMotion still = motion(*world.collider(sphere).value());
       still.linearVelocity = Vec3::Zero();
       ASSERT_TRUE(world.setColliderMotion(sphere, still).ok());
     }
-    world.step(kFrame);
+    health(world.step(kFrame));
     maxStrain = std::max(maxStrain, world.stats().maxStrain);
     const Shape* shape = world.collider(sphere).value();
     for (const Vec3& x : world.positions(cloth).value()) {
@@ -186,6 +190,7 @@ TEST(StrainLimitWorld, ASpherePushedIntoAHangingSheetWithLargeStepsStaysWithinTh
   // The sphere did push the sheet (its middle moved well beyond its plane).
   EXPECT_GT(world.positions(cloth).value()[10 * kVertices + 10].z(), 0.1);
   EXPECT_LE(maxStrain, kAllowed);
+  health.expectHealthy("sphere into a hanging sheet");
 }
 
 
@@ -207,10 +212,12 @@ Real heavyPadOnSheetMaxStrain() {
   World world;
   const ClothId cloth = world.createCloth(model, settings).value();
   Real maxStrain = 0;
+  test::StepHealth health;
   for (int frame = 0; frame < 60; ++frame) {
-    (void)world.step(kStep);
+    health(world.step(kStep));
     maxStrain = std::max(maxStrain, world.stats().maxStrain);
   }
+  health.expectHealthy("heavy pad on a sheet");
   // The pad rests on the sheet, above its lowest vertex.
   const std::span<const Vec3> x = world.positions(cloth).value();
   Real lowestSheet = std::numeric_limits<Real>::infinity();

@@ -1,5 +1,5 @@
 // Helpers shared by the render tests: grid cloths, a draped curtain, pixel statistics and a context
-// fixture that skips only when no EGL display exists at all.
+// fixture that fails without an EGL display (skips only when WEFT_ALLOW_MISSING_EGL=1).
 #pragma once
 
 #include <weft/render/ClothRenderer.h>
@@ -112,9 +112,14 @@ inline std::filesystem::path outputDir() {
   return dir;
 }
 
-/// Creates a context, or skips the test when the machine has no EGL display at all (Mesa's EGL
-/// vendor library missing). Any other failure is a test failure. WEFT_REQUIRE_EGL=1 turns the
-/// skip into a failure too (for CI machines that must render).
+/// Debian packages the render tests need: Mesa's EGL and software rasteriser to run, the
+/// libglvnd headers and stubs to build.
+inline constexpr const char* kEglPackages =
+    "apt-get install libegl-mesa0 libgl1-mesa-dri (to build: libegl-dev libgl-dev libopengl-dev)";
+
+/// Creates a context. A machine without an EGL display fails the test, naming the packages to
+/// install: the suite must really render. WEFT_ALLOW_MISSING_EGL=1 turns that failure into a skip,
+/// for a developer without Mesa. Any other context failure is a test failure.
 class RenderTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -122,9 +127,13 @@ class RenderTest : public ::testing::Test {
     if (!created) {
       const std::string& message = created.error().message;
       const bool noDisplay = message.rfind("no EGL display", 0) == 0;
-      const char* require = std::getenv("WEFT_REQUIRE_EGL");
-      if (noDisplay && !(require && std::string(require) == "1")) {
-        GTEST_SKIP() << "EGL unavailable: " << message;
+      const char* allow = std::getenv("WEFT_ALLOW_MISSING_EGL");
+      if (noDisplay && allow != nullptr && std::string(allow) == "1") {
+        GTEST_SKIP() << "EGL unavailable (WEFT_ALLOW_MISSING_EGL=1): " << message;
+      }
+      if (noDisplay) {
+        FAIL() << "the render tests need an EGL display: " << kEglPackages
+               << "; or set WEFT_ALLOW_MISSING_EGL=1 to skip them. " << message;
       }
       FAIL() << message;
     }

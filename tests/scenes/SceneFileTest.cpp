@@ -246,7 +246,34 @@ INSTANTIATE_TEST_SUITE_P(
                  "/world/windScript/keyframes/1/time", "must increase"},
         BadScene{"WindNotAVector", R"({"version": 1, "world": {"windScript": {"keyframes": [{"time": 0, "wind": 3}]}}, "cloths": [{"grid": {}}]})",
                  "/world/windScript/keyframes/0/wind", "three numbers"},
-        BadScene{"EscapedKey", R"({"version": 1, "a/b~c": 1, "cloths": [{"grid": {}}]})", "/a~1b~0c", "unknown key"}),
+        BadScene{"EscapedKey", R"({"version": 1, "a/b~c": 1, "cloths": [{"grid": {}}]})", "/a~1b~0c", "unknown key"},
+        // Extremes (issue 22): numbers beyond a double, and values the engine would refuse.
+        BadScene{"NumberBeyondADouble", CLOTH(R"(, "material": {"warpStretchStiffness": 1e400})"),
+                 "/cloths/0/material/warpStretchStiffness", "is 1e400, beyond the largest double"},
+        BadScene{"NegativeNumberBeyondADouble", R"({"version": 1, "world": {"gravity": [0, -1e400, 0]}, "cloths": [{"grid": {}}]})",
+                 "/world/gravity/1", "is -1e400, beyond the largest double (about 1.8e308); give a finite number"},
+        BadScene{"HugeStiffness", CLOTH(R"(, "material": {"bendingStiffness": 1e300})"),
+                 "/cloths/0/material/bendingStiffness", "above 1e+30 (kMaxMaterialValue"},
+        BadScene{"HugeSpring", CLOTH(R"(, "springs": {"shearStiffness": 1e31})"),
+                 "/cloths/0/springs/shearStiffness", "kMaxMaterialValue"},
+        BadScene{"HugeGravity", R"({"version": 1, "world": {"gravity": [0, -1e30, 0]}, "cloths": [{"grid": {}}]})",
+                 "/world/gravity", "above 10000 m/s² (kMaxGravity"},
+        BadScene{"HugeWind", R"({"version": 1, "world": {"wind": [3e4, 0, 0]}, "cloths": [{"grid": {}}]})",
+                 "/world/wind", "faster than 10000 m/s (kMaxSpeed)"},
+        BadScene{"HugeWindKeyframe", R"({"version": 1, "world": {"windScript": {"keyframes": [{"time": 0}, {"time": 1, "wind": [0, 0, 1e5]}]}}, "cloths": [{"grid": {}}]})",
+                 "/world/windScript/keyframes/1/wind", "kMaxSpeed"},
+        BadScene{"FastCollider", R"({"version": 1, "cloths": [{"grid": {}}], "colliders": [{"type": "sphere", "radius": 1, "linearVelocity": [0, 0, -1e30]}]})",
+                 "/colliders/0/linearVelocity", "kMaxSpeed"},
+        BadScene{"FarTranslation", CLOTH(R"(, "translation": [1e30, 0, 0])"),
+                 "/cloths/0/translation", "beyond the 1e+06 m a coordinate may have (kMaxCoordinate)"},
+        BadScene{"FarGrid", R"({"version": 1, "cloths": [{"grid": {"origin": [0, 0, 2e6]}}]})",
+                 "/cloths/0/grid", "kMaxCoordinate"},
+        BadScene{"HugePleats", CLOTH(R"(, "initialPleats": {"amplitude": 1e300})"),
+                 "/cloths/0/initialPleats", "kMaxCoordinate"},
+        BadScene{"GridBeyondTheLimit", R"({"version": 1, "cloths": [{"grid": {"columns": 100000, "rows": 100000}}]})",
+                 "/cloths/0/grid", "more than the limit of 4000000 per cloth; use fewer columns and rows"},
+        BadScene{"BadWeldTolerance", R"({"version": 1, "cloths": [{"mesh": {"obj": "weft_no_such_file.obj", "weldTolerance": 2}}]})",
+                 "/cloths/0/mesh/weldTolerance", "below 1"}),
     [](const ::testing::TestParamInfo<BadScene>& info) { return std::string(info.param.name); });
 
 TEST(SceneFile, ReportsEveryMistakeAtOnce) {
@@ -266,6 +293,105 @@ TEST(SceneFile, UnreadableSceneFileNamesIt) {
   outcome = parseSceneFile(std::filesystem::temp_directory_path().string());
   ASSERT_EQ(outcome.issues.size(), 1u);
   EXPECT_THAT(outcome.issues[0].message, HasSubstr("is a directory"));
+}
+
+TEST(SceneFile, DevicesAndOversizedFilesAreRefusedUnread) {
+  // `weft validate /dev/zero` once ended in std::bad_alloc, reading forever.
+  for (const char* device : {"/dev/zero", "/dev/urandom"}) {
+    SceneParseOutcome outcome = parseSceneFile(device);
+    ASSERT_EQ(outcome.issues.size(), 1u) << device;
+    EXPECT_THAT(outcome.issues[0].message,
+                HasSubstr(std::string("scene file '") + device + "': it is a character device"));
+  }
+  // A mesh that is a device, named by its JSON path.
+  SceneParseOutcome mesh = parseSceneText(R"({"version": 1, "cloths": [{"mesh": {"obj": "/dev/zero"}}]})");
+  ASSERT_EQ(mesh.issues.size(), 1u);
+  EXPECT_EQ(mesh.issues[0].path, "/cloths/0/mesh/obj");
+  EXPECT_THAT(mesh.issues[0].message, HasSubstr("OBJ file '/dev/zero': it is a character device"));
+  // Above SceneLoadOptions::maxFileBytes: refused by its size.
+  const std::filesystem::path path = std::filesystem::temp_directory_path() / "weft_big_scene.json";
+  std::ofstream(path) << R"({"version": 1, "cloths": [{"grid": {}}]})";
+  SceneLoadOptions options;
+  options.maxFileBytes = 16;
+  SceneParseOutcome big = parseSceneFile(path.string(), options);
+  ASSERT_EQ(big.issues.size(), 1u);
+  EXPECT_THAT(big.issues[0].message, HasSubstr("bytes, more than the limit of 16 bytes"));
+  EXPECT_TRUE(parseSceneFile(path.string()).scene.has_value());
+  std::filesystem::remove(path);
+}
+
+TEST(SceneFile, GridsBeyondTheMemoryAreRefusedBeforeTheyAreBuilt) {
+  // Within a raised vertex limit, but not within any machine's memory: refused by the estimate.
+  SceneLoadOptions options;
+  options.maxVerticesPerCloth = 4'000'000'000u;
+  SceneParseOutcome outcome = parseSceneText(
+      R"({"version": 1, "cloths": [{"grid": {"columns": 50000, "rows": 40000}}]})", options);
+  ASSERT_EQ(outcome.issues.size(), 1u) << formatIssues(outcome.issues);
+  EXPECT_EQ(outcome.issues[0].path, "/cloths/0/grid");
+  EXPECT_THAT(outcome.issues[0].message,
+              HasSubstr("a cloth of 2000000000 vertices (50000 x 40000 grid) needs about"));
+  EXPECT_THAT(outcome.issues[0].message, HasSubstr("are available; use fewer columns and rows"));
+}
+
+TEST(SceneFile, MeshClothsAreWeldedAndTheirPinsCountTheFilesVertices) {
+  const std::filesystem::path folder = std::filesystem::temp_directory_path() / "weft_scene_seam";
+  std::filesystem::create_directories(folder);
+  // Two quads written as two texture islands: vertices 1 and 4 (0-based) are the same point, and
+  // so are 3 and 6.
+  std::ofstream(folder / "seam.obj") << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\n"
+                                        "v 1 0 0\nv 2 0 0\nv 1 1 0\nv 2 1 0\n"
+                                        "f 1 2 4 3\nf 5 6 8 7\n";
+  auto load = [&](const std::string& mesh, const std::string& pins) {
+    std::ofstream(folder / "scene.json")
+        << R"({"version": 1, "cloths": [{"mesh": {"obj": "seam.obj")" + mesh + R"(}, "pins": )" + pins + "}]}";
+    return loadSceneFile((folder / "scene.json").string());
+  };
+  Result<SceneDescription> scene = load("", R"([{"vertices": [2, 6]}])");
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  const ClothModel& model = *scene->cloths[0].model;
+  EXPECT_EQ(model.vertexCount(), 6u);
+  EXPECT_EQ(model.meshImport().weldedVertices, 2u);
+  // The file's vertex 6 is the model's vertex 3 (the copy of 3 is welded into it).
+  EXPECT_EQ(scene->cloths[0].settings.pinnedVertices, (std::vector<Index>{2, 3}));
+  // Pinning both copies of one point pins one vertex twice.
+  scene = load("", R"([{"vertices": [3]}, {"vertices": [6]}])");
+  ASSERT_FALSE(scene.ok());
+  EXPECT_THAT(scene.error().message, HasSubstr("/cloths/0/pins/1: vertex 6 is already pinned by /cloths/0/pins/0 "
+                                               "(coincident vertices are welded into one)"));
+  // Welding off: eight vertices, and the file's numbers are the model's.
+  scene = load(R"(, "weldVertices": false)", R"([{"vertices": [3, 6]}])");
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  EXPECT_EQ(scene->cloths[0].model->vertexCount(), 8u);
+  EXPECT_EQ(scene->cloths[0].settings.pinnedVertices, (std::vector<Index>{3, 6}));
+  // A wider tolerance and the winding switch are read.
+  scene = load(R"(, "weldTolerance": 1e-4, "fixWinding": false)", "[]");
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  std::filesystem::remove_all(folder);
+}
+
+TEST(SceneFile, AMoebiusStripIsRefusedNamingItsTriangles) {
+  const std::string path =
+      (std::filesystem::path(WEFT_TEST_DATA_DIR).parent_path() / "scenes/data/moebius.json").string();
+  SceneParseOutcome outcome = parseSceneFile(path);
+  ASSERT_EQ(outcome.issues.size(), 1u) << formatIssues(outcome.issues);
+  EXPECT_EQ(outcome.issues[0].path, "/cloths/0/mesh/obj");
+  EXPECT_THAT(outcome.issues[0].message, HasSubstr("moebius.obj"));
+  EXPECT_THAT(outcome.issues[0].message, ::testing::ContainsRegex(
+      "triangles [0-9]+ and [0-9]+ across edge \\([0-9]+, [0-9]+\\) cannot be wound consistently"));
+  EXPECT_THAT(outcome.issues[0].message, HasSubstr("non-orientable (a Möbius strip)"));
+}
+
+TEST(SceneFile, ThreadCountsOutOfRangeAreRefusedWhenTheSceneIsBuilt) {
+  for (int threads : {-1, 100000}) {
+    Result<SceneDescription> description = loadSceneText(R"({"version": 1, "cloths": [{"grid": {"columns": 3, "rows": 3}}]})");
+    ASSERT_TRUE(description.ok());
+    ScriptedSceneSettings settings;
+    settings.threadCount = threads;
+    Result<ScriptedScene> scene = ScriptedScene::create(std::move(description).value(), settings);
+    ASSERT_FALSE(scene.ok()) << threads;
+    EXPECT_THAT(scene.error().message,
+                HasSubstr("WorldSettings::threadCount = " + std::to_string(threads) + " is out of range"));
+  }
 }
 
 TEST(SceneFile, OversizedGridsAreRefusedBeforeTheyAreBuilt) {

@@ -1,7 +1,7 @@
 // Stress scene 9 with the heavy objects as cloths of their own: two 0.5 kg pads dropped on a
 // 0.15 kg sheet pinned at its corners, three cloths of one World, so the pads load the sheet
 // through the contact between cloths (ClothClothCollision, run after every cloth has stepped)
-// instead of the self-collision. The same four conditions as scene 9, and no intersecting pair
+// instead of the self-collision. The same conditions as scene 9, and no intersecting pair
 // between the cloths either.
 #include "engine/ContactTestSupport.h"
 #include "stress/StressSupport.h"

@@ -5,14 +5,16 @@
 //       5 % if it stays flat, and makes it buckle and touch itself if it does not);
 //   10  the pins of a hanging cloth teleported 10 m sideways in one frame: carried with them (a
 //       teleport, SolverSettings::pinTeleportDistance), the cloth passes every condition from
-//       the jump on; with the teleport rule off (dragged at 600 m/s), everything stays finite and
-//       untangled, and the recovery is recorded (it depends on round-off).
+//       the jump on; with the teleport rule off (dragged at 600 m/s) it must recover too, over
+//       six draws of the jump, of which three are known engine failures.
 #include "stress/StressSupport.h"
 
 #include <Eigen/Geometry>
 
 #include <cmath>
 #include <numbers>
+#include <ostream>
+#include <string>
 
 namespace weft::stress {
 namespace {
@@ -68,22 +70,13 @@ TEST(StressPins, StripTwistedByItsTwoPinnedEnds) {
 // substep, strain within the limit in every frame, and the energy back within 1 % of m·g·height
 // of its settled value within 2 s, for good.
 //
-// With the rule off (the second test) the pins move linearly across the frame, dragging the sheet
-// at 600 m/s for 1/60 s and stopping dead. Automatic substepping keeps every pin within one mean
-// edge length per substep (SolverSettings::maxPinTravelPerSubstep), so that frame takes 178
-// substeps and ends at the strain limit; in the next frame the sheet, now at 600 m/s, crashes into
-// the stopped pins. The dragging already crushes edges (the shortest at 14…49 % of its rest length
-// at the drag frame's end in three traced runs), the crash crushes more, and whether every fold
-// comes free depends on round-off: measured with bench/weft-teleport-perturb
-// --pin-teleport-distance 0 (teleport distance changed by 0, 1e-12 … 3e-3 m, pin removal on and
-// off: 24 runs), 6 of 24 keep folds crushed in self-contact for seconds (0.5…6 J above the
-// settled energy, nearly all of it potential, against a 0.14 J band; hundreds of self-impacts a
-// frame, and the self-collision passes stretch edges up to 0.85 after the limiter, which leaves
-// no edge over; no capped solve, no frozen impact zone), and their strain from 2 s on is
-// 0.103…0.134 with the energy not back. Counting the pins' change of velocity as travel (178 substeps for the crash too) made
-// it worse (15 of 24). So with the rule off the recovery is recorded, not asserted; what holds in
-// every perturbed run is asserted: finite, no intersecting pair, no capped solve, and the drag
-// frame itself within the strain limit.
+// With the rule off (StressPinsDragged) the pins move linearly across the frame, dragging the
+// sheet at 600 m/s for 1/60 s and stopping dead. Automatic substepping keeps every pin within one
+// mean edge length per substep (SolverSettings::maxPinTravelPerSubstep), so that frame takes 178
+// substeps and ends at the strain limit; in the next frame the sheet, now at 600 m/s, crashes
+// into the stopped pins. The drag and the crash crush edges (to a tenth of their rest length),
+// and whether every fold comes free afterwards changes with the smallest change of the jump, so
+// the dragged scene runs over draws (below).
 struct TeleportOutcome {
   Real dragFrameStrain = 0;
   Index teleportFrameSubsteps = 0, teleportedCloths = 0;
@@ -91,8 +84,9 @@ struct TeleportOutcome {
 };
 
 // Runs the scene in `world` (empty), watched by `monitor` (made on it).
+// `jumpOffset`: m added to the 10 m jump.
 TeleportOutcome teleportScene(Real pinTeleportDistance, World& world, StressMonitor& monitor,
-                              bool tightSolves = false) {
+                              bool tightSolves = false, Real jumpOffset = 0) {
   constexpr Index kColumns = 13, kRows = 9;
   GridSettings grid;
   grid.columns = kColumns;
@@ -125,7 +119,7 @@ TeleportOutcome teleportScene(Real pinTeleportDistance, World& world, StressMoni
   outcome.scale = model->totalMass(settings.material.arealDensity) * 9.81 * grid.height;
 
   std::vector<Vec3> targets = world.pinTargets(cloth).value();
-  for (Vec3& target : targets) target.x() += 10.0;
+  for (Vec3& target : targets) target.x() += 10.0 + jumpOffset;
   EXPECT_TRUE(world.setPinTargets(cloth, targets).ok());
   const bool dragged = pinTeleportDistance == 0;
   if (dragged) monitor.deferStrain();  // the drag and the crash stretch the cloth on purpose
@@ -172,25 +166,66 @@ TEST(StressPins, PinsTeleportedTenMetresCarryTheClothThere) {
   monitor.expectPasses("teleported_pins", kCottonStrainLimit);  // strain in every frame
 }
 
-TEST(StressPins, PinsDraggedTenMetresInOneFrameStayFiniteAndUntangled) {
+// The dragged jump over draws: the jump changed by 0 … 3 mm (what bench/weft-teleport-perturb
+// --pin-teleport-distance 0 runs, there with pin removal on and off too). Every draw asserts the
+// stress conditions (strain from 2 s after the jump on) and that the energy is back within 1 %
+// of m·g·height for good within 2 s. In the draws of 0.1 mm and more the crash into the stopped
+// pins leaves a fold crushed in self-contact that the self-collision passes hold for the rest of
+// the run (400 to 900 proximity pairs and 200 to 400 swept impacts a frame): they stretch edges
+// after the strain limiter, which itself leaves no edge over. Those two conditions are known
+// engine failures there, with the figures measured (the other conditions still asserted).
+struct DraggedDraw {
+  Real jumpOffset;        // m added to the 10 m jump
+  const char* knownFailure;  // why its recovery fails, with the figures; null: asserted
+};
+
+void PrintTo(const DraggedDraw& draw, std::ostream* out) { *out << "jump + " << draw.jumpOffset << " m"; }
+
+class StressPinsDragged : public ::testing::TestWithParam<DraggedDraw> {};
+
+TEST_P(StressPinsDragged, PinsDraggedTenMetresInOneFrameRecover) {
+  const DraggedDraw draw = GetParam();
   World world;
   StressMonitor monitor(world);
-  const TeleportOutcome outcome = teleportScene(/*pinTeleportDistance=*/0, world, monitor);
+  const TeleportOutcome outcome = teleportScene(/*pinTeleportDistance=*/0, world, monitor,
+                                                /*tightSolves=*/false,
+                                                draw.jumpOffset);
   EXPECT_EQ(outcome.teleportedCloths, 0u);
   EXPECT_EQ(outcome.teleportFrameSubsteps, 178);
-  // The cloth followed its pins, and the drag frame itself stayed within the limit (0.1006 …
-  // 0.1010 in all 48 runs of the harness, sleep on and off).
+  // The cloth followed its pins, and the drag frame itself stayed within the limit.
   EXPECT_GT(outcome.endX, 9.0);
   EXPECT_LE(outcome.dragFrameStrain, kCottonStrainLimit + kStrainTolerance);
   const bool settled = outcome.settledAt >= 0 && outcome.settledAt <= 2.0;
-  constexpr const char* kFragile =
-      "the crash into the stopped pins crushes folds that self-contact can hold for seconds; 6 of "
-      "24 round-off perturbations fail (bench weft-teleport-perturb --pin-teleport-distance 0), so "
-      "a pass here is a draw: keep the mark until the harness shows none failing";
-  monitor.expectPasses("dragged_pins", kCottonStrainLimit,
-                        {{StressMonitor::Condition::Strain, kFragile}});
-  knownEngineFailure(settled, "energy back within 1 % of m·g·height within 2 s", kFragile);
+  const std::string name = "dragged_pins_" + std::to_string(draw.jumpOffset);
+  if (!draw.knownFailure) {
+    EXPECT_TRUE(settled) << "the energy is not back within 1 % of m·g·height for good within 2 s";
+    monitor.expectPasses(name, kCottonStrainLimit);
+    return;
+  }
+  monitor.expectPasses(name, kCottonStrainLimit,
+                       {{StressMonitor::Condition::Strain, draw.knownFailure}});
+  knownEngineFailure(settled, "energy back within 1 % of m·g·height within 2 s", draw.knownFailure);
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Jumps, StressPinsDragged,
+    ::testing::Values(
+        DraggedDraw{0, nullptr}, DraggedDraw{1e-6, nullptr}, DraggedDraw{1e-5, nullptr},
+        DraggedDraw{1e-4, "a fold crushed by the crash stays held in self-contact: strain 1.65 "
+                          "from 2 s on, energy 7 to 11 J above the settled 0.42 J for the 3 s"},
+        DraggedDraw{1e-3, "a fold crushed by the crash stays held in self-contact: strain 0.112 "
+                          "from 2 s on, energy not back within 1 % of m·g·height in 3 s"},
+        DraggedDraw{3e-3, "a fold crushed by the crash stays held in self-contact: strain 1.15 "
+                          "from 2 s on, energy not back within 1 % of m·g·height in 3 s"}),
+    [](const ::testing::TestParamInfo<DraggedDraw>& info) {
+      const Real offset = info.param.jumpOffset;
+      return std::string("plus_") + (offset == 0      ? "0"
+                                     : offset == 1e-6 ? "1um"
+                                     : offset == 1e-5 ? "10um"
+                                     : offset == 1e-4 ? "100um"
+                                     : offset == 1e-3 ? "1mm"
+                                                      : "3mm");
+    });
 
 }  // namespace
 }  // namespace weft::stress

@@ -13,11 +13,11 @@ namespace {
 
 class StressStiffness : public ::testing::TestWithParam<Real> {};
 
-// All four conditions, the solver cap included (< 1 % of frames), asserted at every stiffness.
+// All the conditions, the solver cap included (< 1 % of frames), asserted at every stiffness.
 // Measured with the default Gauss–Seidel preconditioner: no capped frame at any factor (at most
 // 97 iterations in a frame at × 10³, 87 at × 10⁴). With block Jacobi (the default before) × 10³
 // hit the 200-iteration cap in 12 of 90 frames (13 %): weft-solver-compare runs both.
-TEST_P(StressStiffness, SwingingSheetPassesTheFourConditions) {
+TEST_P(StressStiffness, SwingingSheetPassesTheStressConditions) {
   const Real factor = GetParam();
   constexpr Index kVertices = 13;
   World world;

@@ -1,4 +1,4 @@
-// Shared checks of the stress suite (issue 9). Every scene must pass four conditions:
+// Shared checks of the stress suite. Every scene must pass five conditions:
 //
 //   finite        every position and velocity finite after every frame
 //   intersections the collision module's exact counter (SelfIntersectionCounter) finds no
@@ -7,6 +7,11 @@
 //                 every frame stays within the material's strain limit + 1 % (absolute: 0.10 +
 //                 0.01 for cotton, whose ClothMaterial::strainLimit is 0.10)
 //   solver cap    the PCG hits cgMaxIterations (StepStatus::SolverNotConverged) in < 1 % of frames
+//   health        no frame rolled back (StepStatus::RolledBack: the health monitor undid the
+//                 frame, so the cloth reports its start-of-frame state and every other check
+//                 would see a frozen, finite cloth), and no frame retried with a smaller step
+//                 (StepStatus::RetriedWithSmallerStep) beyond the bound a scene declares with
+//                 its reason (StressMonitor::allowRetries; none by default)
 //
 // "The material's limit" is ClothMaterial::strainLimit, which the engine's strain limiter
 // enforces after every solve (engine/src/StrainLimiting.h); cotton's is 0.10, the end of woven
@@ -21,6 +26,9 @@
 // cannot meet a condition say so and record the measured value instead of asserting it (see the
 // scene's comment), and nothing is tuned to pass.
 #pragma once
+
+#include "engine/KnownEngineFailure.h"
+#include "golden/GoldenHashes.h"
 
 #include <weft/collision/SelfIntersectionCounter.h>
 #include <weft/engine/FabricPresets.h>
@@ -57,19 +65,10 @@ inline std::shared_ptr<const ClothModel> horizontalSquare(Index vertices, Real s
   return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
 }
 
-/// A scene-specific check the engine is known to fail: printed and, when it fails, the test ends
-/// SKIPPED with the reason instead of failing (see StressMonitor::KnownFailure). When it passes,
-/// the message says to drop the mark.
-inline void knownEngineFailure(bool passed, const std::string& what, const char* reason) {
-  std::printf("[stress] KNOWN ENGINE FAILURE, not asserted: %s (%s): %s\n", what.c_str(),
-              passed ? "passes now; drop the mark" : "fails", reason);
-  if (!passed) {
-    ::testing::Test::RecordProperty("known_failure", what + ": " + reason);
-    GTEST_SKIP() << "KNOWN ENGINE FAILURE: " << what << ": " << reason;
-  }
-}
+/// A scene-specific check the engine is known to fail (engine/KnownEngineFailure.h).
+using test::knownEngineFailure;
 
-/// Watches the cloths of one world frame by frame and collects the four conditions.
+/// Watches the cloths of one world frame by frame and collects the five conditions.
 class StressMonitor {
  public:
   /// `intersectionEvery`: count intersecting pairs after every n-th frame (1 = every frame).
@@ -83,6 +82,13 @@ class StressMonitor {
         SelfIntersectionCounter::create(model.indices(), model.restPositions()).value());
   }
 
+  /// Declares that up to `bound` frames of this scene may be retried with a smaller step, and
+  /// why its physics needs it (one line, printed with the report). Without it, none may be.
+  void allowRetries(int bound, const char* reason) {
+    m_allowedRetries = bound;
+    m_retryReason = reason;
+  }
+
   /// From now on StepStats::maxStrain counts toward the strain condition (before: forced strain
   /// of the scene's set-up). Watching starts measuring at once unless this is deferred.
   void deferStrain() { m_measureStrain = false; }
@@ -92,8 +98,8 @@ class StressMonitor {
   bool afterFrame(StepStatus status) {
     ++m_frames;
     if (hasFlag(status, StepStatus::SolverNotConverged)) ++m_capHits;
-    if (hasFlag(status, StepStatus::RolledBack)) ++m_rolledBack;
-    if (hasFlag(status, StepStatus::RetriedWithSmallerStep)) ++m_retried;
+    if (hasFlag(status, StepStatus::RolledBack) && m_rolledBack++ == 0) m_firstRolledBack = m_frames;
+    if (hasFlag(status, StepStatus::RetriedWithSmallerStep) && m_retried++ == 0) m_firstRetried = m_frames;
     m_limiterLeftOver += m_world.stats().strainLimitEdgesOver;
     if (m_measureStrain) m_maxStrain = std::max(m_maxStrain, m_world.stats().maxStrain);
     m_peakStrain = std::max(m_peakStrain, m_world.stats().maxStrain);
@@ -123,6 +129,17 @@ class StressMonitor {
     return total;
   }
 
+  /// The health condition alone (part of expectPasses): no frame rolled back, retries within
+  /// the declared bound.
+  void expectHealthy(const std::string& name) const {
+    EXPECT_EQ(m_rolledBack, 0) << name << ": " << m_rolledBack << " frames rolled back by the "
+                               << "health monitor (the first after frame " << m_firstRolledBack << ")";
+    EXPECT_LE(m_retried, m_allowedRetries)
+        << name << ": " << m_retried << " frames retried with a smaller step (the first after "
+        << "frame " << m_firstRetried << "); allowed " << m_allowedRetries
+        << (m_retryReason ? std::string(": ") + m_retryReason : std::string());
+  }
+
   int frames() const { return m_frames; }
   int capHits() const { return m_capHits; }
   int rolledBack() const { return m_rolledBack; }
@@ -134,8 +151,11 @@ class StressMonitor {
   Index maxIntersections() const { return m_maxIntersections; }
   Real capFraction() const { return m_frames ? Real(m_capHits) / m_frames : 0; }
 
-  /// Prints and records the figures under `name`.
+  /// Prints and records the figures under `name`, and checks the world's state against its
+  /// golden hash "stress/<name>" (tests/golden/GoldenHashes.h): every scene reports, so every
+  /// scene and every draw of a parameterised one is pinned.
   void report(const std::string& name) const {
+    test::expectGoldenHash("stress/" + name, m_world.stateHash());
     std::printf("[stress] %-40s frames %5d  max strain %.4f (peak %.4f)  intersections %u "
                 "(checked %d times)  cap hits %d (%.2f %%)  retried %d  rolled back %d  edges the "
                 "strain limiter left over %llu\n",
@@ -155,7 +175,7 @@ class StressMonitor {
     const char* reason;
   };
 
-  /// The four conditions as test expectations; `strainLimit` is the material's limit. Conditions
+  /// The five conditions as test expectations; `strainLimit` is the material's limit. Conditions
   /// in `known` are reported instead of asserted (see KnownFailure).
   void expectPasses(const std::string& name, Real strainLimit = kCottonStrainLimit,
                     std::initializer_list<KnownFailure> known = {}) const {
@@ -177,6 +197,7 @@ class StressMonitor {
       EXPECT_TRUE(passed) << name << ": " << what;
     };
     EXPECT_EQ(m_nonFiniteFrames, 0) << name << ": frames with non-finite state";
+    expectHealthy(name);
     EXPECT_GT(m_intersectionChecks, 0) << name;
     check(Condition::Intersections, m_maxIntersections == 0,
           std::to_string(m_maxIntersections) + " intersecting triangle pairs (first after frame " +
@@ -200,6 +221,8 @@ class StressMonitor {
   std::vector<SelfIntersectionCounter> m_counters;
   bool m_measureStrain = true;
   int m_frames = 0, m_capHits = 0, m_rolledBack = 0, m_retried = 0, m_nonFiniteFrames = 0;
+  int m_firstRolledBack = -1, m_firstRetried = -1, m_allowedRetries = 0;
+  const char* m_retryReason = nullptr;
   int m_intersectionChecks = 0, m_firstIntersectingFrame = -1;
   Real m_maxStrain = 0, m_peakStrain = 0;
   Index m_maxIntersections = 0;

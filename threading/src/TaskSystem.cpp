@@ -23,9 +23,17 @@ void* PartialBuffer::reserve(std::size_t bytes) {
 
 }  // namespace detail
 
+std::string validate(const TaskSystemSettings& settings) {
+  if (settings.threadCount >= 0 && settings.threadCount <= TaskSystemSettings::kMaxThreadCount) return {};
+  return "TaskSystemSettings::threadCount = " + std::to_string(settings.threadCount) +
+         " is out of range: give 0 (the machine's cores), 1 (serial) or up to " +
+         std::to_string(TaskSystemSettings::kMaxThreadCount) + " threads";
+}
+
 namespace {
 int resolveThreadCount(int requested) {
-  assert(requested >= 0 && "TaskSystem::Settings::threadCount must be >= 0 (0 = all cores)");
+  // Out of range (validate() names the mistake): the serial reference, which spawns nothing.
+  if (requested < 0 || requested > TaskSystemSettings::kMaxThreadCount) return 1;
   if (requested > 0) return requested;
   // hardware_concurrency() may return 0 when it cannot tell: fall back to the serial reference.
   return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));

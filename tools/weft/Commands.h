@@ -18,7 +18,7 @@ struct RunOptions {
   unsigned captureEvery = 1;     ///< capture every Nth frame
   std::string exportObjDirectory;  ///< OBJ frames of every cloth
   unsigned exportEvery = 1;      ///< export every Nth frame
-  bool checkIntersections = false;  ///< count intersecting triangle pairs each frame (not timed)
+  bool checkIntersections = false;  ///< count intersecting pairs each frame (not timed); exit 3 if any
   bool quiet = false;            ///< no progress output
   std::string summaryJson;       ///< write the report as JSON here
 };

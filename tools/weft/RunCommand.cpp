@@ -1,6 +1,10 @@
 // weft run: simulate a scene file frame by frame, optionally draw, capture and export, and
 // report frame times, solver figures, contacts, status flags and the state hash.
 //
+// Exit status: 0 when the run completed, 1 on an error, 2 on bad options, and 3 when
+// --check-intersections found an intersecting triangle pair in any frame (the report is complete
+// and the summary written either way), so that scripts and CI can gate on it.
+//
 // Timing covers stepFrame() only (scripts + World::step); drawing, intersection counting and OBJ
 // export are measured apart or not at all, so the simulation figures mean the same with and
 // without them. Frame 1 is left out of the percentiles: it pays for first-touch page faults.
@@ -152,6 +156,12 @@ int runScene(const RunOptions& options, std::ostream& out) {
       << "  frames     " << frames << " of " << scenario.frameDt * 1000 << " ms ("
       << frames * scenario.frameDt << " s simulated), threads " << scene.world().threadCount() << "\n";
   if (!options.quiet && !scenario.description.empty()) out << "  about      " << scenario.description << "\n";
+  for (const ClothDescription& cloth : scenario.cloths) {
+    const MeshImport& import = cloth.model->meshImport();
+    if (import.weldedVertices == 0 && import.flippedTriangles == 0) continue;
+    out << "  mesh       '" << cloth.name << "': welded " << import.weldedVertices
+        << " coincident vertices, flipped " << import.flippedTriangles << " triangles\n";
+  }
 
 #if WEFT_HAVE_RENDER
   std::unique_ptr<SceneDrawing> drawing;
@@ -215,6 +225,7 @@ int runScene(const RunOptions& options, std::ostream& out) {
   StepStatus seen = StepStatus::Ok;
   double maxStrain = 0;
   Index maxContacts = 0, maxSelfContacts = 0, maxIntersections = 0, framesWithIntersections = 0;
+  long firstIntersectingFrame = 0;  // 0: none
   long cgIterations = 0;
   unsigned exported = 0;
   Progress progress(out, frames, options.quiet);
@@ -250,6 +261,7 @@ int runScene(const RunOptions& options, std::ostream& out) {
       const Index pairs = counter->count(allPositions);
       maxIntersections = std::max(maxIntersections, pairs);
       framesWithIntersections += pairs > 0;
+      if (pairs > 0 && firstIntersectingFrame == 0) firstIntersectingFrame = frame;
     }
     if (!options.exportObjDirectory.empty() && (frame % options.exportEvery == 0 || frame == frames)) {
       for (std::size_t k = 0; k < scene.clothCount(); ++k) {
@@ -302,7 +314,9 @@ int runScene(const RunOptions& options, std::ostream& out) {
       << "  status         " << statuses.describe() << "\n";
   if (counter) {
     out << "  intersections  " << maxIntersections << " pairs at most, in " << framesWithIntersections
-        << " frame(s)\n";
+        << " frame(s)";
+    if (firstIntersectingFrame > 0) out << ", the first after frame " << firstIntersectingFrame;
+    out << "\n";
   }
   if (!options.exportObjDirectory.empty()) {
     out << "  exported       " << exported << " OBJ file(s) to " << options.exportObjDirectory << "\n";
@@ -324,6 +338,8 @@ int runScene(const RunOptions& options, std::ostream& out) {
         {"max_self_contacts", maxSelfContacts},
         {"status", describe(seen)},
         {"intersections", counter ? std::int64_t(maxIntersections) : std::int64_t(-1)},
+        {"frames_with_intersections", counter ? std::int64_t(framesWithIntersections) : std::int64_t(-1)},
+        {"first_intersecting_frame", counter ? std::int64_t(firstIntersectingFrame) : std::int64_t(-1)},
         {"state_hash", hex(hash)},
     };
     std::ofstream file(options.summaryJson);
@@ -334,6 +350,12 @@ int runScene(const RunOptions& options, std::ostream& out) {
       return 1;
     }
     out << "  summary        " << options.summaryJson << "\n";
+  }
+  if (framesWithIntersections > 0) {
+    out << "weft run: FAILED --check-intersections: " << maxIntersections
+        << " intersecting triangle pairs at most, in " << framesWithIntersections
+        << " frame(s), the first after frame " << firstIntersectingFrame << "\n";
+    return 3;
   }
   return 0;
 }

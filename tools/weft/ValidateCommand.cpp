@@ -22,6 +22,15 @@ int validateScenes(const ValidateOptions& options, std::ostream& out) {
     const SceneDescription& scene = *outcome.scene;
     const std::size_t cloths = scene.cloths.size(), colliders = scene.colliders.size();
     const Index frames = scene.frames;
+    // What the mesh import changed, so a seam welded or a face flipped is never a surprise.
+    std::string notes;
+    for (const ClothDescription& cloth : scene.cloths) {
+      const MeshImport& import = cloth.model->meshImport();
+      if (import.weldedVertices == 0 && import.flippedTriangles == 0) continue;
+      notes += "  cloth '" + cloth.name + "' (" + cloth.objPath + "): welded " +
+               std::to_string(import.weldedVertices) + " coincident vertices, flipped " +
+               std::to_string(import.flippedTriangles) + " triangles to a consistent winding\n";
+    }
     ScriptedSceneSettings settings;
     settings.threadCount = 1;  // building only: no need for a thread pool
     Result<ScriptedScene> built = ScriptedScene::create(std::move(*outcome.scene), settings);
@@ -31,7 +40,7 @@ int validateScenes(const ValidateOptions& options, std::ostream& out) {
       continue;
     }
     out << path << ": valid (" << cloths << " cloth(s), " << colliders << " collider(s), " << frames
-        << " frames)\n";
+        << " frames)\n" << notes;
   }
   if (invalid == 0) {
     out << "all " << options.scenes.size() << " scene files are valid\n";

@@ -26,7 +26,7 @@ int main(int argc, char** argv) {
   runCommand->add_option("--export-every", run.exportEvery, "Export every Nth frame (and the last)")
       ->check(CLI::PositiveNumber);
   runCommand->add_flag("--check-intersections", run.checkIntersections,
-                       "Count intersecting triangle pairs every frame (not timed)");
+                       "Count intersecting triangle pairs every frame (not timed); exit status 3 if any frame has one");
   runCommand->add_flag("--quiet", run.quiet, "No progress output");
   runCommand->add_option("--summary-json", run.summaryJson, "Write the report as JSON here");
 

@@ -1,7 +1,7 @@
 // Scalar and vector types shared by every module above threading.
 //
-// Weft computes in double precision: the implicit solve, the accuracy references of DESIGN.md §6
-// and the finite-difference tests of the force kernels all want it, and at curtain sizes the
+// Weft computes in double precision: the implicit solve, the accuracy references of the
+// error-versus-time sweep and the finite-difference tests of the force kernels all want it, and at curtain sizes the
 // state is small enough that bandwidth, not precision, is not what limits a step. Renderers
 // convert to float at the boundary.
 //

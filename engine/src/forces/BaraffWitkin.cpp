@@ -38,6 +38,17 @@ constexpr Real kPi = std::numbers::pi_v<Real>;
 /// The Hessian grows like 1/|w|, so the threshold also caps it at a finite 1e8 · √a · weights².
 constexpr Real kMinStretchRatio = 1e-8;
 
+/// A unit vector across the unit vector `d`: the world axis least aligned with it (the first on
+/// a tie), less its part along d.
+Vec3 acrossDirection(const Vec3& d) {
+  int axis = 0;
+  for (int k = 1; k < 3; ++k) {
+    if (std::abs(d[k]) < std::abs(d[axis])) axis = k;
+  }
+  const Vec3 e = Vec3::Unit(axis);
+  return (e - e.dot(d) * d).normalized();
+}
+
 /// A hinge whose edge, or whose triangle heights, are below this fraction of its longest edge is
 /// treated as degenerate: θ's gradient grows like 1/height and its Hessian like 1/height².
 constexpr Real kDegenerateHingeRatio = 1e-8;
@@ -71,14 +82,22 @@ Real angleFromNormals(const Vec3& normalA, const Vec3& normalB, const Vec3& edge
   return angle <= -kPi ? kPi : angle;
 }
 
-/// Fills a stretch condition √a (|w| − b) for w = Σ weights[i] x_i.
-void fillStretchCondition(const Vec3& w, const std::array<Real, 3>& weights, Real sqrtArea,
-                          Real restScale, bool withHessian, Condition<3>& condition) {
+/// Fills a stretch condition √a (|w| − b) for w = Σ weights[i] x_i. `collapsedDirection` (unit)
+/// stands for w / |w| when |w| is below kMinStretchRatio (the fibre collapsed to a point).
+void fillStretchCondition(const Vec3& w, const Vec3& collapsedDirection,
+                          const std::array<Real, 3>& weights, Real sqrtArea, Real restScale,
+                          bool withHessian, Condition<3>& condition) {
   condition.convex = true;  // |w| is convex in w and w is linear in x
   const Real length = w.norm();
   condition.value = sqrtArea * (length - restScale);
   if (!(length > kMinStretchRatio)) {
-    return;  // direction undefined: zero gradient and Hessian
+    // Any unit vector is a subgradient of |w| at 0; the given one pushes the fibre open. The
+    // Hessian, (I − ŵŵᵀ)/|w|, is unbounded there; it enters the system only for a stretched
+    // condition (Condition.h), and this one is compressed, so it is left zero.
+    for (int i = 0; i < 3; ++i) {
+      condition.gradient.segment<3>(3 * i) = (sqrtArea * weights[i]) * collapsedDirection;
+    }
+    return;
   }
   const Vec3 direction = w / length;
   for (int i = 0; i < 3; ++i) {
@@ -144,9 +163,18 @@ StretchConditions stretchConditions(const Vec3& x0, const Vec3& x1, const Vec3& 
   // √a rather than BW98's a: E = k a/2 (|w| − b)², so k is in N/m on any mesh resolution.
   const Real sqrtArea = std::sqrt(rest.area);
 
+  // A fibre collapsed to a point (|w| ≈ 0: every vertex of a cloth on one point or one line) has
+  // no direction, and without one it feels no stretch force and never opens. It is given one
+  // across the other fibre, or, both collapsed, warp along x and weft across it: the same rule on
+  // every triangle, so that a collapsed cloth is pushed open consistently toward a flat sheet.
+  const bool warpCollapsed = !(warp.norm() > kMinStretchRatio);
+  const bool weftCollapsed = !(weft.norm() > kMinStretchRatio);
+  Vec3 warpFallback = Vec3::UnitX(), weftFallback = Vec3::UnitY();
+  if (warpCollapsed && !weftCollapsed) warpFallback = acrossDirection(weft.normalized());
+  if (weftCollapsed) weftFallback = acrossDirection(warpCollapsed ? warpFallback : warp.normalized());
   StretchConditions conditions;
-  fillStretchCondition(warp, wu, sqrtArea, warpRestScale, withHessian, conditions.warp);
-  fillStretchCondition(weft, wv, sqrtArea, weftRestScale, withHessian, conditions.weft);
+  fillStretchCondition(warp, warpFallback, wu, sqrtArea, warpRestScale, withHessian, conditions.warp);
+  fillStretchCondition(weft, weftFallback, wv, sqrtArea, weftRestScale, withHessian, conditions.weft);
   return conditions;
 }
 

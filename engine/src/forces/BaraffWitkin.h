@@ -32,9 +32,13 @@
 // The bend gradient and Hessian are exact: derivatives of θ(z) with respect to z = (n_A, n_B, e),
 // chained through the bilinear maps z(x) including their constant second derivatives.
 //
-// Degenerate geometry (|w| ≈ 0, collapsed edges, zero-area triangles) gives a finite value and a
-// zero gradient and Hessian for that condition: the direction the force would act in is undefined,
-// and zero is the only choice that cannot inject energy.
+// Degenerate geometry gives finite values. A stretch fibre collapsed to a point (|w| ≈ 0) has no
+// direction; any unit vector is a subgradient of |w| there, and the kernel takes one across the
+// other fibre (both collapsed: warp along x, weft along y), the same on every triangle, so that a
+// cloth collapsed onto a line or a point is pushed open instead of feeling no stretch force. The
+// force lowers the energy whatever the direction (the condition is compressed); its Hessian is
+// zero (it is unbounded, and a compressed condition's is not used). Collapsed bend hinges and
+// springs give a zero gradient and Hessian: zero is the only choice that cannot inject energy.
 #pragma once
 
 #include <forces/Condition.h>

@@ -21,7 +21,8 @@ Vec3 areaNormal(const Vec3& x0, const Vec3& x1, const Vec3& x2) {
 }  // namespace
 
 BendingStencils buildBendingStencils(const Vec3Array& x, const std::vector<Index>& indices,
-                                     const std::vector<Edge>& edges) {
+                                     const std::vector<Edge>& edges,
+                                     const std::vector<Index>& skipped) {
   const Index vertexCount = static_cast<Index>(x.size());
   const Index triangleCount = static_cast<Index>(indices.size() / 3);
   // Incident triangles and edges per vertex, in mesh order (CSR).
@@ -64,7 +65,7 @@ BendingStencils buildBendingStencils(const Vec3Array& x, const std::vector<Index
       ring.push_back({edge.vertices[0] == v ? edge.vertices[1] : edge.vertices[0], {}});
       if (edge.triangles[1] == kInvalidIndex - 1) manifold = false;
     }
-    if (!manifold || triangles == 0) continue;
+    if (!manifold || triangles == 0 || std::binary_search(skipped.begin(), skipped.end(), v)) continue;
     std::sort(ring.begin() + 1, ring.end(),
               [](const RingVertex& a, const RingVertex& b) { return a.vertex < b.vertex; });
     auto weightsOf = [&ring](Index vertex) -> std::array<Real, 4>& {

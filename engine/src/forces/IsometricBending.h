@@ -9,9 +9,9 @@
 // costs 2.3–3× the continuum energy, one bent about the split diagonal ≈ 9×. Bergou's per-edge
 // quadratic form approximates the same hinge energy and inherits that.
 //
-// Why not Bergou's vertex form D/2 Σ_v |Δx|² A_v (cotangent Laplacian; tried): |Δx|² = (κ₁ + κ₂)²
+// Why not Bergou's vertex form D/2 Σ_v |Δx|² A_v (cotangent Laplacian): |Δx|² = (κ₁ + κ₂)²
 // is a plate with Poisson ratio 1. Saddles (κ₂ = −κ₁) cost nothing, and in the small-deflection
-// limit the membrane does not resist them either: a 3-vertex-wide cantilever strip came out at
+// limit the membrane does not resist them either: a 3-vertex-wide cantilever strip comes out at
 // 0.53 D. Cloth has a Poisson ratio near 0 and D is measured on strips (ASTM D1388).
 //
 // Energy: the plate with Poisson ratio 0, W = D/2 |∇²x|² = D/2 Σ_ab |∂_a ∂_b x|² over the rest
@@ -28,7 +28,7 @@
 //
 //     E = D/2 Σ_s c_s |S_s(x) − α_s n_v(x)|²,   c = 1/A_v, 1/A_v, 2/A_v
 //
-// Measured on a 41 × 41 grid (cylinders of curvature 3/m): interior energy within 0.1 % of
+// Accuracy on a 41 × 41 grid (cylinders of curvature 3/m): interior energy within 0.1 % of
 // D/2 κ² A in every direction; the whole sheet 2.6 % low when bent across two of its edges (the
 // cell of a free-edge vertex does not see curvature across the edge, where the bending moment of a
 // free edge vanishes anyway), 0.2 % off along the diagonal. On a cantilever the vertex at the
@@ -73,10 +73,12 @@ struct BendingStencils {
 
 /// Builds the stencils of a mesh from its rest positions and triangles. `edges` as in ClothModel,
 /// where triangles[1] == kInvalidIndex marks a boundary edge and kInvalidIndex − 1 an edge shared
-/// by more than two triangles.
+/// by more than two triangles. Vertices on such edges, and those in `skipped` (bowties: fans
+/// that meet at a point transmit no bending), get no stencil.
 BendingStencils buildBendingStencils(const Vec3Array& restPositions,
                                      const std::vector<Index>& indices,
-                                     const std::vector<Edge>& edges);
+                                     const std::vector<Edge>& edges,
+                                     const std::vector<Index>& skipped = {});
 
 /// S(x) = Σ_j w_j x_j over the stencil's weights (the centre's included), in m.
 Vec3 stencilVector(const BendingStencil& stencil, std::span<const StencilWeight> weights,

@@ -10,19 +10,15 @@ namespace weft {
 namespace {
 
 // Re-solves of a step after the self-contact active set changed (ImplicitEuler::
-// updateActiveCouplings); each costs a warm-started solve. Measured on the corner crumple (15
-// runs, see Cloth.cpp's kSelfContactSearch): 1, 2 and 4 passes settled 9, 10 and 9 of 15 for
-// 37, 40 and 38 CG iterations per frame over the last 100 frames. Without the active set (every
-// pair within a thickness at the start kept, pulling or not) the default-tolerance drop stood
-// as a 15 cm pile still stirring at 1e-4 J after 400 frames: the springs glued the layers.
+// updateActiveCouplings); each costs a warm-started solve. One pass settles crumpled cloth about
+// as often as four. Without the active set (every pair within a thickness at the start kept,
+// pulling or not) the penalty springs glue the layers and a crumpled pile keeps stirring.
 constexpr int kContactReleasePasses = 2;
 // Re-solves of a step after contact constraints that pulled were released (BW98 §5.3): a
 // constraint whose impulse (A Δv − b)·n is negative holds a vertex on a collider that the
 // cloth's forces would take off it. A released vertex is free in the re-solve; the collider
-// response still keeps it out. The curtain takes 11.5 CG iterations per frame with the friction
-// changes of 2026-11-23 (11.2 before; ColliderResponse.h). Without the release the pressed
-// shell of ColliderResponse::constrain glued cloth to the floor (ColliderSliding's sheet,
-// pulled 1.5 m up, stayed down: strain 29).
+// response still keeps it out. Without the release the pressed shell of
+// ColliderResponse::constrain glues cloth to the floor (a sheet pulled 1.5 m up stays down).
 constexpr int kConstraintReleasePasses = 2;
 
 }  // namespace

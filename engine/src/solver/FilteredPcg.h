@@ -33,8 +33,8 @@
 //   M, and Â ĉ = t + P_L⁻¹(ĉ − D̃ t), t = P_L⁻ᵀ ĉ, costs one backward and one forward half-sweep,
 //   i.e. one SpMV of work, instead of an SpMV plus two triangular solves. Δv is updated with t
 //   directly (Δv += α t), so nothing is transformed back at the end. The off-diagonal blocks are
-//   copied once per solve into sweep order so the sweeps stream. Measured on the curtain ×1 (one
-//   thread): 0.45x the iterations and 0.70x the solve time of block Jacobi (weft-solver-compare).
+//   copied once per solve into sweep order so the sweeps stream. On the curtain it takes about
+//   half the iterations of block Jacobi (weft-solver-compare, bench/results/solver-defaults.md).
 //   Rejected: natural-order Gauss–Seidel and block IC(0) (sequential sweeps: no parallel version
 //   with the same bits), and multigrid (worth it only well beyond the ×16 curtain).
 // - Stopping, two tests (PcgStopping).
@@ -56,18 +56,11 @@
 //   window sees the soft ones the residual is blind to. Measured at every iteration k ≥ w, fused
 //   into the update pass: a ring of the last w iterates (slot k mod w holds Δv_{k−w} until
 //   iteration k reads it and writes Δv_k there), so a solve ends at the first iteration that
-//   meets the test, not at the next multiple of w. Measured (issue 7, branch verrwindow): with the
-//   test only every w-th iteration the curtain's solves piled up at 8 and 12 iterations; checked
-//   at every one they spread from 4 to 22, the quick sweep's defaults take 0.89x the CG
-//   iterations at 0.94x the error (10.40 → 9.27 a frame, RMS 0.0205 → 0.0193), and the 10 s
-//   curtain is unchanged (11.6 → 11.7: a warm start inherits what the last solve left). One more
-//   read and write of a vector per iteration; w vectors of memory.
-//   Measured on stress scene 2 with block Jacobi (issue 7): the bound alone hits the 200-iteration
-//   cap in 87 of 90 frames at ×10⁴ (tolerance 1e-2); the energy norm ‖e‖_A (bound or
-//   Hestenes–Stiefel, window 4) in 3 and 2 frames at ×10² and ×10⁴ (3e-2); this test in none at
-//   any stiffness (3e-2 and 5e-2), ×10³ included, which capped 12 of 90 frames with the old test
-//   at 1e-3. The window progress alone (without the residual's agreement) stopped the static
-//   validation scenes early (tolerance 1e-10, a chain 5e-8 m off its symmetric twin). Rejected:
+//   meets the test, not at the next multiple of w (checked only every w-th iteration, solves pile
+//   up at multiples of w). One more read and write of a vector per iteration; w vectors of memory.
+//   On a stiff sheet (×10⁴ cotton) the bound alone is too pessimistic and hits the iteration cap;
+//   this test does not (bench/results/error-time-curtain.md has the figures). The window alone,
+//   without the residual's agreement, stops static scenes early, where CG crawls. Rejected:
 //   the residual relative to b in the M⁻¹ norm (b's elastic part sets the scale: on a jammed stack
 //   it allowed 20–60 % velocity errors) and the energy norm relative to anything holding b's
 //   elastic part, for the same reason.
@@ -75,10 +68,10 @@
 //   block-Jacobi norm of r = S(b − AΔv) for either preconditioner, compared with the same norm of
 //   the reference r_ref = S(b − A(I − S)z), the residual of the cold start, which does not depend
 //   on the initial guess (BW98 use filter(b), which also ignores the pull of moving pins). It stops
-//   when ‖r‖_{D̃⁻¹} ≤ max(tolerance · ‖r_ref‖_{D̃⁻¹}, absoluteTolerance). Its flaw, and why the
-//   engine left it: D̃ ≈ m + h²k, so an error in a soft mode (where A e ≈ M e) shows in the residual
-//   only as (m/(m + h²k))^{1/2} of its size; on stiff or jammed cloth a "1 %" residual measured
-//   30–100 % velocity errors (stress scenes 2 and 7, bench/results/error-time-curtain.md).
+//   when ‖r‖_{D̃⁻¹} ≤ max(tolerance · ‖r_ref‖_{D̃⁻¹}, absoluteTolerance). Its flaw, and why it is
+//   not the default: D̃ ≈ m + h²k, so an error in a soft mode (where A e ≈ M e) shows in the
+//   residual only as (m/(m + h²k))^{1/2} of its size; on stiff or jammed cloth a "1 %" residual can
+//   hide velocity errors of tens of per cent (bench/results/error-time-curtain.md).
 //   Both: the absolute floor handles a vanishing right-hand side (cloth at rest on its pins), where
 //   no relative goal is reachable. Gauss–Seidel's CG only carries r̂ = P_L⁻¹ r and rᵀM_SGS⁻¹r; it
 //   scales the start's exact stopping norm by the fall of √(rᵀM_SGS⁻¹r) into an estimate, and
@@ -150,8 +143,7 @@ struct PcgSettings {
   Real velocityFloor = 1e-3;
   /// VelocityError only: iterations per progress window; the velocity change over a window is
   /// the estimate of the error left at its start (header, "Stopping"). Longer is safer and stops
-  /// later; 4 measured enough on the stress scenes (bench/results/error-time-curtain.md; windows 2
-  /// to 7 on the curtain's quick sweep are there too).
+  /// later; 4 is enough on the stress scenes (bench/results/error-time-curtain.md).
   int progressWindow = 4;
   /// Which preconditioner (SolverSettings::preconditioner). The stopping norm does not depend on
   /// it, so the tolerance means the same accuracy whichever is used.

@@ -40,7 +40,8 @@ struct Aabb {
   }
   /// True when the closed boxes share at least one point.
   bool overlaps(const Aabb& other) const {
-    // Short-circuit &&: measured faster in the self query than a branch-free `&` of all six.
+    // Short-circuit &&: most box pairs of the self query fail the first test, so it is faster
+    // there than a branch-free `&` of all six.
     return min.x() <= other.max.x() && other.min.x() <= max.x() &&  //
            min.y() <= other.max.y() && other.min.y() <= max.y() &&  //
            min.z() <= other.max.z() && other.min.z() <= max.z();
@@ -65,6 +66,7 @@ struct Aabb {
     return (below + above).squaredNorm();
   }
 
+  /// Same corners, bit for bit.
   friend bool operator==(const Aabb& a, const Aabb& b) { return a.min == b.min && a.max == b.max; }
 };
 

@@ -65,10 +65,8 @@
 // the other vertices and edges of two triangles around one vertex (a fan folding onto itself);
 // a proximity or CCD stage that needs them must add them from the mesh topology.
 //
-// Cost, measured once on the ×16 curtain (161 × 121 vertices, 38,400 triangles, thickness 3 mm,
-// serial code, one core of the shared 2-core dev machine under load): refit 0.24 ms; self query
-// 3.4 ms flat or wavy (95k candidate pairs, almost all non-adjacent neighbours whose inflated
-// boxes touch) and 6.8 ms gathered to 30 % of its width (155k pairs).
+// Cost: a refit is a small fraction of a self query, which is dominated by the candidate pairs of
+// non-adjacent neighbours whose inflated boxes touch (bench/results/threading-and-bvh.md).
 #pragma once
 
 #include <weft/Math.h>
@@ -107,9 +105,8 @@ inline bool trianglesShareVertex(const std::array<Index, 3>& a, const std::array
 /// AABB tree over the triangles of one mesh (see the design note above).
 class Bvh {
  public:
-  /// Most triangles in one leaf. Self query on the ×16 curtain (38,400 triangles, wavy /
-  /// gathered to 30 %), measured once: 4 → 5.8 / 11.5 ms, 8 → 3.8 / 8.6, 16 → 3.2 / 6.5,
-  /// 32 → 3.2 / 5.8. 16 keeps most of the gain while leaf loops stay short (leaves hold 9–16).
+  /// Most triangles in one leaf. Larger leaves make the self query faster up to about 16 and
+  /// the leaf loops longer; 16 keeps most of the gain (bench/results/threading-and-bvh.md).
   static constexpr Index kMaxLeafTriangles = 16;
   /// Level at which the self query is cut into independent tasks (up to 2^kTaskLevel of them).
   static constexpr Index kTaskLevel = 5;
@@ -149,12 +146,14 @@ class Bvh {
   /// triangles moved less than m, and every internal node above only skipped children. Raising it
   /// skips more refits and prunes the queries less (their results never change).
   void setRefitMargin(Real margin) { m_refitMargin = margin; }
+  /// m, the refit margin (setRefitMargin()).
   Real refitMargin() const { return m_refitMargin; }
   /// Nodes the last refit recomputed and nodes it kept (sum: nodes().size()).
   struct RefitCounts {
     Index refitNodes = 0;    ///< nodes whose box was recomputed
     Index skippedNodes = 0;  ///< nodes whose box was kept
   };
+  /// What the last refit() recomputed and kept.
   const RefitCounts& lastRefitCounts() const { return m_lastRefit; }
 
   /// Clears `pairs`, then writes every pair (i < j) of triangles whose boxes overlap and that

@@ -46,11 +46,10 @@
 // contact: it must be far below the cloth thickness (3 mm) and above the rounding of positions
 // (1e-16 · |x|). Time precision is 1e-13 of the step for a clean crossing. For grazing motion,
 // whose normal speed is a fraction r of the tangential one, rounding in f moves the root by
-// about ε / r (measured: 6e-6 of the step at r = 1e-8); the normal offset at the reported time
-// stays ~ε · |x|, so the contact is still real (distance ≤ tolerance), only its time is blurred.
-// Measured on 200,000 random constructed crossings (sizes 1 mm to 1 m, 10 m from the origin,
-// r from 1e-9 to 0.1) and 100,000 coplanar / parallel motions: no miss, no contact farther than
-// `tolerance`; crossings 1e-5 m beside an edge: no false contact.
+// about ε / r (6e-6 of the step at r = 1e-8); the normal offset at the reported time stays
+// ~ε · |x|, so the contact is still real (distance ≤ tolerance), only its time is blurred.
+// The tests check the contract on random constructed crossings (sizes 1 mm to 1 m, far from the
+// origin, r down to 1e-9), coplanar and parallel motions, and near misses beside an edge.
 #pragma once
 
 #include <weft/Math.h>

@@ -1,5 +1,5 @@
-// SelfIntersectionCounter: how many triangle pairs of a mesh intersect (the check of DESIGN.md
-// §5, "zero self-intersections in every frame"; the curtain runner's --check-intersections).
+// SelfIntersectionCounter: how many triangle pairs of a mesh intersect (the check behind the
+// target "zero self-intersections in every frame"; the curtain runner's --check-intersections).
 //
 // Broad phase: the mesh's Bvh refit to the positions with zero thickness and queried for self
 // pairs (pairs sharing a vertex are skipped there). Narrow phase: the exact triangle–triangle

@@ -2,8 +2,8 @@
 //
 // Design note
 // -----------
-// Used to count intersecting triangle pairs (the "zero self-intersections" target of DESIGN.md
-// §5), where a wrong answer either hides a tunnelling bug or reports one that is not there.
+// Used to count intersecting triangle pairs (the "zero self-intersections" target), where a
+// wrong answer either hides a tunnelling bug or reports one that is not there.
 //
 // Method. Two closed triangles intersect exactly when an edge of one meets the other triangle
 // (6 segment–triangle tests): if they cross, the ends of their intersection segment lie on edges;

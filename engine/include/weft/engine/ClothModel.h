@@ -32,6 +32,7 @@
 
 #include <weft/Math.h>
 #include <weft/Result.h>
+#include <weft/engine/InputLimits.h>
 
 #include <array>
 #include <cstdint>
@@ -89,9 +90,9 @@ enum class SpringKind : std::uint8_t {
 
 /// One spring of the mass-spring network.
 struct Spring {
-  std::array<Index, 2> vertices{};
+  std::array<Index, 2> vertices{};  ///< the two vertices it joins
   Real restLength = 0;  ///< m
-  SpringKind kind = SpringKind::Structural;
+  SpringKind kind = SpringKind::Structural;  ///< which family (and so which stiffness) it has
 };
 
 /// An undirected mesh edge and the triangles on either side.
@@ -125,11 +126,34 @@ struct TriangleMesh {
 /// How a mesh becomes a cloth model.
 struct MeshSettings {
   Vec3 warpDirection{1.0, 0.0, 0.0};  ///< direction of the warp (u) when no material coordinates
-  /// Reject edges shared by more than two triangles (bending needs a manifold). When false, such
-  /// edges simply get no hinge.
+  /// Reject edges shared by more than two triangles and bowtie vertices (two fans of triangles
+  /// meeting at one vertex): bending needs a manifold. False: such edges get no hinge and such
+  /// vertices no isometric bending stencil.
   bool requireManifold = true;
   /// A triangle whose area is below this fraction of its longest edge squared is degenerate.
   Real degenerateAreaRatio = 1e-8;
+  /// Merge vertices closer than weldTolerance (exporters write a vertex once per UV island).
+  /// False keeps the copies: a cut along each seam, its two borders in contact. Default true.
+  bool weldVertices = true;
+  /// Fraction of the mesh's bounding-box diagonal within which vertices are welded; default
+  /// 1e-6 (1 µm on a 1 m cloth, above the rounding of six written decimals).
+  Real weldTolerance = 1e-6;
+  /// Flip triangles so each connected piece winds like its lowest-numbered triangle (bending and
+  /// normals need one orientation). False: inconsistent winding is an error. Default true.
+  bool fixWinding = true;
+};
+
+/// What fromMesh() did to the mesh it was given (ClothModel::meshImport()).
+struct MeshImport {
+  Index weldedVertices = 0;    ///< input vertices merged into an earlier coincident one
+  Index flippedTriangles = 0;  ///< triangles reversed to agree with their connected piece
+  Index components = 0;        ///< connected pieces (triangles joined through shared edges)
+  /// The model vertex of each input vertex; empty when the numbering is unchanged (no weld).
+  std::vector<Index> modelVertexOfInput;
+  /// The model vertex of input vertex `input` (of the mesh given to fromMesh()).
+  Index modelVertex(Index input) const {
+    return modelVertexOfInput.empty() ? input : modelVertexOfInput[input];
+  }
 };
 
 /// Immutable cloth topology and rest state. Build with grid(), fromMesh() or loadObj().
@@ -137,23 +161,36 @@ class ClothModel {
  public:
   /// A rectangular grid with the classic structural/shear/flexion spring network.
   static Result<ClothModel> grid(const GridSettings& settings);
-  /// A general triangle mesh; validated (indices, finiteness, degeneracy, manifoldness).
+  /// A general triangle mesh: validated (indices, finite positions within kMaxCoordinate,
+  /// degeneracy, manifoldness, memory), its coincident vertices welded and its winding made
+  /// consistent (MeshSettings); meshImport() reports what changed. Errors name input vertices
+  /// and triangles by their index in `mesh`.
   static Result<ClothModel> fromMesh(const TriangleMesh& mesh, const MeshSettings& settings = {});
-  /// Reads positions and triangles (polygons are fanned) from a Wavefront OBJ file.
+  /// bytes, the largest OBJ file readObj() reads (a 4-million-vertex cloth with texture
+  /// coordinates takes about 600 MB).
+  static constexpr std::uint64_t kMaxObjFileBytes = 1ull << 30;
+  /// Reads positions and triangles from a Wavefront OBJ file (see parseObj()). Refuses anything
+  /// but a regular file of at most kMaxObjFileBytes, without reading it.
   static Result<TriangleMesh> readObj(const std::string& path);
-  /// Parses Wavefront OBJ text held in memory, as readObj() does a file (material libraries are
-  /// not read). `source` names the text in messages, e.g. "OBJ file 'cape.obj'".
+  /// Parses Wavefront OBJ text held in memory: "v" and "f" statements (quads split along the
+  /// shorter inside diagonal, larger polygons ear-clipped); errors name the line. `source` names
+  /// the text in messages, e.g. "OBJ file 'cape.obj'".
   static Result<TriangleMesh> parseObj(std::string_view text, std::string_view source = "OBJ text");
   /// readObj() followed by fromMesh().
   static Result<ClothModel> loadObj(const std::string& path, const MeshSettings& settings = {});
 
+  /// Number of vertices.
   Index vertexCount() const { return static_cast<Index>(m_restPositions.size()); }
+  /// Number of triangles.
   Index triangleCount() const { return static_cast<Index>(m_triangles.size()); }
 
+  /// m, the rest shape, one position per vertex.
   const Vec3Array& restPositions() const { return m_restPositions; }
   /// Three vertex indices per triangle, in the mesh's winding (for rendering and collision).
   const std::vector<Index>& indices() const { return m_indices; }
+  /// Per triangle: vertices and rest quantities of the Baraff–Witkin stretch and shear terms.
   const std::vector<TriangleRest>& triangles() const { return m_triangles; }
+  /// Interior edges with their two triangles: the dihedral bending hinges.
   const std::vector<Hinge>& hinges() const { return m_hinges; }
   /// Isometric bending terms, three per vertex (vertices next to non-manifold edges have none),
   /// in vertex order.
@@ -162,7 +199,9 @@ class ClothModel {
   const std::vector<StencilWeight>& bendingWeights() const { return m_bendingWeights; }
   /// Triangles whose normals the curved-rest stencils need (BendingStencil::firstTriangle).
   const std::vector<Index>& bendingTriangles() const { return m_bendingTriangles; }
+  /// Every undirected mesh edge (strain, strain limiting, collision).
   const std::vector<Edge>& edges() const { return m_edges; }
+  /// The mass-spring network (ForceModel::MassSpring).
   const std::vector<Spring>& springs() const { return m_springs; }
   /// m², a third of the rest area of every triangle around each vertex (lumped mass = ρ_A · area).
   const std::vector<Real>& vertexAreas() const { return m_vertexAreas; }
@@ -176,11 +215,23 @@ class ClothModel {
   Real characteristicLength() const { return m_characteristicLength; }
   /// Grid dimensions when built by grid(), {0, 0} otherwise.
   std::array<Index, 2> gridSize() const { return m_gridSize; }
+  /// What fromMesh() welded and flipped (all zero for grid()).
+  const MeshImport& meshImport() const { return m_meshImport; }
+
+  /// bytes, an upper bound on the heap a model of this size needs while fromMesh() or grid()
+  /// builds it (about 1.3 times the measured peak; the model keeps about half of it).
+  static std::uint64_t estimatedBuildBytes(std::uint64_t vertices, std::uint64_t triangles);
 
  private:
   ClothModel() = default;
+  // Rest state and derived topology of a checked, welded and oriented mesh. `inputOfModel` maps
+  // model vertices to the caller's numbering for messages (empty: the same); `bowtieVertices`
+  // (ascending) get no bending stencil. `meshSprings`: derive the spring network from the mesh
+  // (grid() builds its own).
   static Result<ClothModel> build(const TriangleMesh& mesh, const MeshSettings& settings,
-                                  const std::vector<Vec2>& perCornerMaterialCoordinates);
+                                  const std::vector<Vec2>& perCornerMaterialCoordinates,
+                                  const std::vector<Index>& inputOfModel,
+                                  const std::vector<Index>& bowtieVertices, bool meshSprings);
   void buildMeshSprings();
 
   Vec3Array m_restPositions;
@@ -196,6 +247,7 @@ class ClothModel {
   Real m_totalArea = 0;
   Real m_characteristicLength = 0;
   std::array<Index, 2> m_gridSize{0, 0};
+  MeshImport m_meshImport;
 };
 
 }  // namespace weft

@@ -11,8 +11,8 @@
 //   - stretch: the low-strain slope of the Wang et al. 2011 fits, which, like the curtain's
 //     260 N/m, is the small-load regime, far softer than the KES secant at 500 gf/cm;
 //   - damping, friction and contact thickness: engineering estimates (no measurement behind them).
-// "cotton" is exactly ClothMaterial{} — the curtain material of DESIGN.md §4 — and a test keeps it
-// so. The others are scaled estimates; treat them as starting points, not measurements.
+// "cotton" is ClothMaterial{} (the curtain's material) with a strain limit of 0.10, and a test
+// keeps it so. The others are scaled estimates; treat them as starting points, not measurements.
 #pragma once
 
 #include <weft/Result.h>
@@ -23,7 +23,7 @@
 
 namespace weft {
 
-/// Light cotton (lawn/shirting): exactly ClothMaterial{}, the curtain material of DESIGN.md §4.
+/// Light cotton (lawn/shirting): ClothMaterial{}, the curtain's material, with strainLimit 0.10.
 ClothMaterial cottonFabric();
 /// Wool suiting: heavier, softer in shear, stiffer in bending than cotton.
 ClothMaterial woolFabric();

@@ -19,6 +19,7 @@
 
 namespace weft {
 
+/// Turns variable display frame times into a whole number of fixed simulation steps.
 class FixedStepAccumulator {
  public:
   /// `step` in s (> 0, finite; otherwise 1/60 s), at most `maxStepsPerFrame` (≥ 1) steps per

@@ -6,7 +6,8 @@
 // same strains (Baraff & Witkin 1998, §2.3): a stiffness k with damping k_d behaves like a
 // Rayleigh damper of time constant k_d / k.
 //
-// The defaults are the cotton-like curtain material of DESIGN.md §4.
+// The defaults are the curtain's cotton (docs/curtain-benchmark.md) without a strain limit; the
+// fabric presets (FabricPresets.h) give common fabrics, limits included.
 #pragma once
 
 #include <weft/Math.h>
@@ -40,16 +41,9 @@ struct ClothMaterial {
   Real airDrag = 0.1;                 ///< N·s/m³, linear drag per area on velocity relative to air
   Real thickness = 0.003;             ///< m, contact thickness (collision)
   Real friction = 0.3;                ///< Coulomb friction coefficient (collision)
-  /// Strain l / l_rest − 1 that no mesh edge may exceed at the end of a step: the strain
-  /// limiter (Provot 1995, Bridson et al. 2002) corrects each step's velocities after the solve,
-  /// before collisions, which keep the last word. 0 or infinity turns it off. Woven fabric
-  /// leaves its low-strain regime, where the stretch stiffness above holds, at about 10 %: past
-  /// it the yarns are straight and the cloth is nearly inextensible. Lower = stiffer feel.
-  /// Off by default; the fabric presets carry their limits (cotton 0.10), and the curtain uses
-  /// cotton's. Opt-in because the limiter and the collision passes after it are not yet solved
-  /// together: with it on in every cloth, contact-heavy scenes regressed (a sheet left by a
-  /// withdrawing sphere 1.7 cm from where it would hang, crumpled cloth on a floor or a sphere
-  /// that keeps stirring instead of settling, a layer pushed 7 mm into a pusher sphere).
+  /// Strain l / l_rest − 1 that no mesh edge exceeds at the end of a step (strain limiting,
+  /// Provot 1995; woven fabric is nearly inextensible past ~10 %). Lower feels stiffer and costs
+  /// limiter iterations. 0 or infinity = off (default); the fabric presets set it (cotton 0.10).
   Real strainLimit = 0.0;
 };
 

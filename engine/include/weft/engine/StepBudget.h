@@ -19,18 +19,12 @@ namespace weft {
 struct StepBudget {
   /// ms of wall-clock time one World::step() may take; 0 = no budget (the cloths' own settings).
   Real milliseconds = 0;
-  /// The loosest PCG tolerance a plan may use, in the sense of the cloths' cgStopping (a cloth
-  /// whose own cgTolerance is looser keeps its own). A plan's tolerance replaces
-  /// SolverSettings::cgTolerance only: hard substeps (a cloth jammed in self-contact or yanked by
-  /// its pins) are still tightened to tightCgTolerance, so a small budget never loosens the
-  /// solves whose error the corrections after them amplify. The default equals the default
-  /// cgTolerance (velocity error 1e-1, near the front of the curtain's error-vs-time sweep): the
-  /// default solve is already the loosest measured safe, and a budget meets a small frame with
-  /// the iteration cap and fewer substeps. (With the old relative-residual default, 1e-1 let the
-  /// curtain stretch without bound through the sphere push.)
+  /// The loosest PCG tolerance a plan may use, in the sense of the cloths' cgStopping; a cloth
+  /// whose own cgTolerance is looser keeps its own, and hard substeps keep tightCgTolerance.
+  /// Default: the default cgTolerance, so a budget meets a small frame with the cap and substeps.
   Real loosestCgTolerance = 1e-1;
   /// PCG iterations per solve a plan never goes below: a solve cut much shorter leaves the step
-  /// closer to explicit Euler than to implicit. Measured on the curtain: 30 is stable, 10 is not.
+  /// closer to explicit Euler than to implicit, and can go unstable.
   int fewestCgIterations = 30;
   /// Implicit substeps a plan may drop to per frame (explicit integrators keep their stable
   /// count: dropping substeps would make them blow up, not merely less accurate).
@@ -50,6 +44,7 @@ struct StepPlan {
   Index substeps = 0;       ///< substeps per frame (0: SolverSettings, automatic or fixed)
   Real cgTolerance = 0;     ///< relative PCG tolerance (0: SolverSettings::cgTolerance)
   int cgMaxIterations = 0;  ///< PCG iteration cap per solve (0: SolverSettings::cgMaxIterations)
+  /// Same fields.
   friend bool operator==(const StepPlan&, const StepPlan&) = default;
 };
 

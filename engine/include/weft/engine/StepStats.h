@@ -50,7 +50,7 @@ std::string describe(StepStatus status);
 enum class HealthFailure : std::uint8_t {
   None = 0,
   NonFinite,   ///< a position or velocity became NaN or infinite
-  Speed,       ///< a vertex moved faster than 10⁴ m/s
+  Speed,       ///< a vertex moved faster than kMaxSpeed (10⁴ m/s, InputLimits.h)
   Strain,      ///< an edge grew to more than 100× its rest length, longer than at the frame start
   EnergyJump,  ///< kinetic energy rose 100× above what the frame's own sources could supply
 };
@@ -90,10 +90,9 @@ struct StepStats {
   /// Strain-limiter iterations (ClothMaterial::strainLimit), summed over cloths and substeps;
   /// 0 when no edge went over its cloth's limit (or every limit is off).
   int strainLimitIterations = 0;
-  /// Edges the strain limiter left over limit + 0.001 after its last iteration (it stopped at
-  /// its iteration cap), summed over cloths and substeps; edges with both ends pinned are not
-  /// counted (nothing can shorten them). Collisions run after the limiter and may stretch edges
-  /// a little more: StepStats::maxStrain is what the frame ended with.
+  /// Edges the strain limiter left over limit + 0.001 at its iteration cap, summed over cloths
+  /// and substeps (edges with both ends pinned not counted). The collision passes after it may
+  /// stretch edges a little more: maxStrain is what the frame ended with.
   Index strainLimitEdgesOver = 0;
 
   // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
@@ -128,10 +127,10 @@ struct StepStats {
   /// frame): 3 per free vertex, since pinned vertices are removed from the system
   /// (SolverSettings::removePinnedVertices); 3 per vertex when they are kept. 0 without a solve.
   Index solvedUnknowns = 0;
-  /// Self-collision BVH nodes whose boxes were recomputed (all refits of all substeps), and
-  /// nodes kept because their triangles moved less than a margin since their last refit
-  /// (WorldSettings::skipUnneededStages; the collision results are the same bits either way).
+  /// Self-collision BVH nodes whose boxes were recomputed (all refits of all substeps).
   Index bvhNodesRefit = 0;
+  /// BVH nodes kept because their triangles moved less than a margin since their last refit
+  /// (WorldSettings::skipUnneededStages; the collision results are the same bits either way).
   Index bvhNodesSkipped = 0;
 };
 

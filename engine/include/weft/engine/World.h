@@ -37,7 +37,9 @@ class SubstepPipeline;  // internal: the frame's substeps
 struct ClothId {
   std::uint32_t index = 0;       ///< slot + 1 (0 = null)
   std::uint32_t generation = 0;  ///< must match the slot's generation
+  /// True for the zero-initialised (null) handle.
   bool isNull() const { return index == 0; }
+  /// Same slot and generation.
   friend bool operator==(const ClothId&, const ClothId&) = default;
 };
 
@@ -45,7 +47,9 @@ struct ClothId {
 struct ColliderId {
   std::uint32_t index = 0;       ///< slot + 1 (0 = null)
   std::uint32_t generation = 0;  ///< must match the slot's generation
+  /// True for the zero-initialised (null) handle.
   bool isNull() const { return index == 0; }
+  /// Same slot and generation.
   friend bool operator==(const ColliderId&, const ColliderId&) = default;
 };
 
@@ -87,11 +91,9 @@ struct ClothSettings {
   /// Keeps the cloth from passing through itself (Bridson, Fedkiw & Anderson 2002). Costs a BVH
   /// refit and queries per substep; turn off for cloth that cannot fold onto itself.
   bool selfCollision = true;
-  /// Keeps the cloth's faces, not only its vertices, out of every collider but a plane: a
-  /// body thinner than the triangles (a 2 cm rod or plank under 5 cm edges) otherwise passes
-  /// between the vertices, and the cloth falls through it or hangs on it by a stretched edge.
-  /// Costs a box test per triangle per nearby collider per collision pass (and a tree query for
-  /// a mesh), and closest-point tests near the body; turn off only for meshes much finer than every collider.
+  /// Keeps the cloth's faces, not only its vertices, out of every collider but a plane, so a rod
+  /// or plank thinner than the triangles cannot pass between the vertices. Costs a box test per
+  /// triangle per nearby collider and pass; turn off only for meshes much finer than every collider.
   bool faceContacts = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
   /// Keeps the cloth from passing through other cloths of the world that have this switch on
@@ -108,9 +110,13 @@ class WorldState {
  public:
   WorldState();
   ~WorldState();
+  /// A deep copy (a moved-from state copies as empty).
   WorldState(const WorldState&);
+  /// A deep copy (a moved-from state copies as empty).
   WorldState& operator=(const WorldState&);
+  /// Moves the snapshot; the moved-from state is empty and refused by restoreState().
   WorldState(WorldState&&) noexcept;
+  /// Moves the snapshot; the moved-from state is empty and refused by restoreState().
   WorldState& operator=(WorldState&&) noexcept;
 
  private:
@@ -123,30 +129,42 @@ class WorldState {
 struct WorldSettings {
   Vec3 gravity{0.0, -9.81, 0.0};  ///< m/s²
   Vec3 wind{0.0, 0.0, 0.0};       ///< m/s, air velocity felt through ClothMaterial::airDrag
-  /// Threads the world's loops run on, the caller's included: 0 = the machine's cores, 1 = serial.
-  /// Results are bitwise the same for every count. Ignored when taskSystem is given.
+  /// Threads the world's loops run on, the caller's included: 0 = the machine's cores, 1 = serial,
+  /// at most TaskSystemSettings::kMaxThreadCount. The same bits for every count. Ignored when
+  /// taskSystem is given.
   int threadCount = 0;
   /// The caller's own task system (and so its oneTBB arena), which must outlive the world. Null:
   /// the world makes one with threadCount threads. Nothing else spawns threads.
   TaskSystem* taskSystem = nullptr;
-  /// Skip the stages a scene does not need: the narrow phase against colliders whose box is not
-  /// near the cloth, self-collision for a cloth that cannot fold onto itself, bending and damping
-  /// terms whose coefficients are zero. The skips are exact (same bits) except the self-collision
-  /// cull, which is conservative by a stated margin (see FoldCulling). Off: every stage runs
-  /// every substep, for checking that the skips change nothing. Sleeping is ClothSettings::sleep.
+  /// Skip the stages a scene does not need (far colliders, self-collision of cloth that cannot
+  /// touch itself, zero bending and damping terms, refits of still parts): the same bits, except
+  /// the conservative self-collision cull. Off: every stage runs, to check that. docs/tuning.md.
   bool skipUnneededStages = true;
 };
 
+/// Owns cloths and colliders and steps them (see the note at the top of this file).
 class World {
  public:
+  /// A world, or an error naming the field of `settings` that is wrong (gravity not finite or
+  /// beyond kMaxGravity, wind beyond kMaxSpeed, threadCount out of range) and the fix.
+  static Result<World> create(const WorldSettings& settings = {});
+  /// A world without the check; it makes its own task system unless settings.taskSystem is
+  /// given. Invalid settings make every createCloth() fail with the error create() would give.
   explicit World(const WorldSettings& settings = {});
   ~World();
+  /// Move-only: handles stay valid in the moved-to world.
   World(World&&) noexcept;
+  /// Move-only: handles stay valid in the moved-to world.
   World& operator=(World&&) noexcept;
 
   /// Adds a cloth. Fails with a message on invalid settings (non-positive density, negative
-  /// stiffness, pins out of range, non-finite pose...), leaving the world unchanged.
+  /// stiffness, a value beyond kMaxMaterialValue, pins out of range, non-finite pose, a vertex
+  /// placed beyond kMaxCoordinate...) or when its estimated memory is not available, leaving the
+  /// world unchanged.
   Result<ClothId> createCloth(std::shared_ptr<const ClothModel> model, const ClothSettings& settings);
+  /// bytes, an upper bound on the heap a cloth of this size takes in a world through its first
+  /// frames (about 1.3 times the measured peak; the shared model not included).
+  static std::uint64_t estimatedClothBytes(std::uint64_t vertices, std::uint64_t triangles);
   /// Removes a cloth; its handle (and copies of it) become stale.
   Status destroyCloth(ClothId cloth);
 
@@ -154,16 +172,18 @@ class World {
   /// ClothSettings::pinnedVertices, same order). Pins move linearly across the frame; when every
   /// pin jumps farther than SolverSettings::pinTeleportDistance, or the pins turn rigidly by more
   /// than SolverSettings::pinTeleportAngle, the frame is a teleport and the cloth is carried with
-  /// them instead of dragged. On error nothing changes.
+  /// them instead of dragged. Targets must be finite and within kMaxCoordinate; on error nothing
+  /// changes.
   Status setPinTargets(ClothId cloth, std::span<const Vec3> targets);
   /// Adds a kinematic collider (plane, sphere, capsule, box or triangle mesh; see
   /// weft/collision). Its motion (pose and velocities) is the shape's own; it moves with those
-  /// velocities during each step until setColliderMotion() changes them.
+  /// velocities during each step until setColliderMotion() changes them. Its linear velocity
+  /// must be within kMaxSpeed.
   Result<ColliderId> addCollider(const Shape& shape, const ColliderSettings& settings = {});
   /// Removes a collider; its handle becomes stale.
   Status destroyCollider(ColliderId collider);
   /// Sets the collider's pose now and its linear (m/s) and angular (rad/s) velocity for the
-  /// following steps. Validated; on error nothing changes.
+  /// following steps. Validated (a linear velocity within kMaxSpeed); on error nothing changes.
   Status setColliderMotion(ColliderId collider, const RigidMotion& motion);
   /// The collider's shape, posed where it is now; valid until the next step or destroy.
   Result<const Shape*> collider(ColliderId collider) const;
@@ -183,21 +203,22 @@ class World {
 
   /// N, a force on each vertex of the cloth (one per vertex, in vertex order), applied every
   /// substep until changed; an empty span removes them. Pinned vertices ignore it. Game forces
-  /// such as a blast, a hand pulling or a scripted gust go here. Wakes the cloth. On error
-  /// nothing changes.
+  /// such as a blast, a hand pulling or a scripted gust go here. Wakes the cloth. Each within
+  /// kMaxMaterialValue N; on error nothing changes.
   Status setExternalForces(ClothId cloth, std::span<const Vec3> forces);
   /// m/s, the air velocity every cloth feels through ClothMaterial::airDrag from the next step
-  /// on (WorldSettings::wind at creation); wakes every cloth. Must be finite; on error nothing
-  /// changes.
+  /// on (WorldSettings::wind at creation); wakes every cloth. Must be finite and within
+  /// kMaxSpeed; on error nothing changes.
   Status setWind(const Vec3& wind);
   /// m/s, the current air velocity.
   const Vec3& wind() const { return m_settings.wind; }
 
   /// Replaces a cloth's positions (m) and velocities (m/s), e.g. to start from a draped shape or
   /// to teleport it. Pinned vertices jump with it and their targets are set to the new positions.
-  /// Sizes must match the vertex count and every value must be finite; on error nothing changes.
+  /// Sizes must match the vertex count, every value must be finite, positions within
+  /// kMaxCoordinate and velocities within kMaxSpeed; on error nothing changes.
   Status setState(ClothId cloth, std::span<const Vec3> positions, std::span<const Vec3> velocities);
-  /// Changes gravity (m/s²) for every cloth and wakes them all. Finite values only.
+  /// Changes gravity (m/s²) for every cloth and wakes them all. Finite, within kMaxGravity.
   Status setGravity(const Vec3& gravity);
   /// Wakes a sleeping cloth (no effect on an awake one).
   Status wake(ClothId cloth);
@@ -280,6 +301,7 @@ class World {
 
   std::unique_ptr<SubstepPipeline> m_pipeline;  // every frame's substeps
   std::uint64_t m_identity = 0;  // unique per World, so a state saved elsewhere is refused
+  std::string m_settingsError;   // why the settings are invalid (then createCloth refuses)
 };
 
 }  // namespace weft

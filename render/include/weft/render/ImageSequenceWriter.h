@@ -1,6 +1,6 @@
 // ImageSequenceWriter: frames to dir/frame_00000.png, frame_00001.png, ... on a background thread.
 //
-// PNG encoding of a 720p frame costs more than a frame (DESIGN.md §9), so write() only copies the
+// PNG encoding of a 720p frame costs more than a frame (40–150 ms), so write() only copies the
 // image into a small queue and returns; one worker thread encodes in order. When the queue is full
 // write() waits (back-pressure beats unbounded memory). Errors are kept and returned by the next
 // write() and by finish(): a full disk stops the capture, not the simulation.

@@ -1,5 +1,5 @@
 // Settings of ClothRenderer: camera, resolution, colours, light; and the per-frame timing it reports.
-// Every field has a default that shows the curtain of DESIGN.md §4 from the front.
+// Every field has a default that shows the curtain (docs/curtain-benchmark.md) from the front.
 #pragma once
 
 #include <weft/Math.h>
@@ -11,6 +11,7 @@ struct ColorRgb {
   float r = 0;  ///< red, 0–1
   float g = 0;  ///< green, 0–1
   float b = 0;  ///< blue, 0–1
+  /// Same channels.
   friend bool operator==(const ColorRgb&, const ColorRgb&) = default;
 };
 

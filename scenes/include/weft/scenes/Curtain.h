@@ -1,4 +1,5 @@
-// The curtain benchmark of DESIGN.md §4: the reference scene every test and benchmark shares.
+// The curtain benchmark: the reference scene every test and benchmark shares
+// (docs/curtain-benchmark.md).
 //
 // A 2.0 m × 1.5 m cotton curtain in the z = 0 plane (x from −1 to +1, y from 0.5 to 2.0), its
 // top row pinned to a rod. Script over 10 s at 60 frames/s:
@@ -15,8 +16,16 @@
 #include <weft/engine/World.h>
 
 #include <memory>
+#include <span>
 
 namespace weft {
+
+/// A named interval of the curtain's script (for charts and reports).
+struct CurtainPhase {
+  Real begin = 0;         ///< s, start of the phase
+  Real end = 0;           ///< s, end of the phase
+  const char* name = "";  ///< what happens, e.g. "sphere pushes"
+};
 
 /// Settings of a curtain run.
 struct CurtainSettings {
@@ -54,8 +63,11 @@ class CurtainScene {
   /// The same, running a given plan (World::step(frameDt, plan)), e.g. to replay a budgeted run.
   StepStatus stepFrame(const StepPlan& plan);
 
+  /// The world the curtain runs in.
   World& world() { return *m_world; }
+  /// The world the curtain runs in.
   const World& world() const { return *m_world; }
+  /// The curtain's handle.
   ClothId cloth() const { return m_cloth; }
   /// The pushing sphere (null handle when CurtainSettings::sphere is false).
   ColliderId sphere() const { return m_sphere; }
@@ -64,12 +76,18 @@ class CurtainScene {
   static constexpr Real kSphereRadius = 0.25;  ///< m
   /// Where the script puts the sphere's centre at time t (s).
   static Vec3 spherePosition(Real t);
+  /// The curtain's model (its grid at this size).
   const ClothModel& model() const { return *m_model; }
+  /// The same model, shared (to build another cloth from it).
   std::shared_ptr<const ClothModel> sharedModel() const { return m_model; }
   /// Frames stepped so far.
   Index frame() const { return m_frame; }
   /// Sets the script's frame counter (after World::restoreState() to a save taken at `frame`).
   void rewindTo(Index frame) { m_frame = frame; }
+
+  /// The script's phases in time order, 0 to 10 s: the intervals of spherePosition() and
+  /// pinTarget(), and the rest between them.
+  static std::span<const CurtainPhase> phases();
 
   /// Grid vertices along the width and height for a size (41 × 31 for size 1).
   static std::array<Index, 2> gridSize(Index size);

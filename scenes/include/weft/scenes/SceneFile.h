@@ -135,9 +135,9 @@ struct SceneDescription {
   std::vector<WindKeyframe> windKeyframes; ///< empty: the wind stays `wind`
   Index frames = 600;             ///< frames of a full run
   Real frameDt = 1.0 / 60.0;      ///< s per frame
-  SceneCamera camera;
-  std::vector<ClothDescription> cloths;
-  std::vector<ColliderDescription> colliders;
+  SceneCamera camera;             ///< for `weft run --render`
+  std::vector<ClothDescription> cloths;        ///< at least one, in file order
+  std::vector<ColliderDescription> colliders;  ///< in file order
 };
 
 /// One problem in a scene file.
@@ -150,19 +150,23 @@ struct SceneIssue {
 struct SceneLoadOptions {
   /// Directory that relative OBJ paths are resolved against (loadSceneFile: the file's own).
   std::string baseDirectory = ".";
-  Index maxVerticesPerCloth = 4'000'000;  ///< grids and meshes above this are refused
-  Index maxIssues = 50;                   ///< stop collecting after this many problems
+  /// Grids and meshes above this are refused, and so is any cloth whose model and world state
+  /// (ClothModel::estimatedBuildBytes + World::estimatedClothBytes) exceed the available memory.
+  Index maxVerticesPerCloth = 4'000'000;
+  Index maxIssues = 50;                    ///< stop collecting after this many problems
+  std::uint64_t maxFileBytes = 64ull << 20;  ///< bytes; larger scene files are refused unread
 };
 
 /// The outcome of parsing: a description when `issues` is empty.
 struct SceneParseOutcome {
-  std::optional<SceneDescription> scene;
-  std::vector<SceneIssue> issues;
+  std::optional<SceneDescription> scene;  ///< the validated scene; none when there are issues
+  std::vector<SceneIssue> issues;         ///< every problem found (up to maxIssues)
 };
 
 /// Parses and validates scene JSON. Never throws.
 SceneParseOutcome parseSceneText(std::string_view json, const SceneLoadOptions& options = {});
-/// Reads and parses a scene file; relative OBJ paths are resolved against its directory.
+/// Reads and parses a scene file (a regular file of at most options.maxFileBytes); relative OBJ
+/// paths are resolved against its directory.
 SceneParseOutcome parseSceneFile(const std::string& path, SceneLoadOptions options = {});
 
 /// parseSceneFile() as a Result: the error lists one "path: message" line per issue.

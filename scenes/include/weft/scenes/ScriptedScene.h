@@ -47,14 +47,19 @@ class ScriptedScene {
   /// motion the world refuses (non-finite) is skipped and flagged StepStatus::InvalidInput.
   StepStatus stepFrame();
 
+  /// The world the scene runs in (add cloths or colliders, read state, save and restore).
   World& world() { return *m_world; }
+  /// The world the scene runs in.
   const World& world() const { return *m_world; }
+  /// The description the scene was built from.
   const SceneDescription& description() const { return m_description; }
   /// Handle of cloth k (file order).
   ClothId cloth(std::size_t k) const { return m_cloths[k]; }
   /// Handle of collider k (file order).
   ColliderId collider(std::size_t k) const { return m_colliders[k]; }
+  /// Number of cloths of the file.
   std::size_t clothCount() const { return m_cloths.size(); }
+  /// Number of colliders of the file.
   std::size_t colliderCount() const { return m_colliders.size(); }
   /// Frames stepped so far.
   Index frame() const { return m_frame; }

@@ -64,6 +64,7 @@
 #include <cstdint>
 #include <memory>
 #include <new>
+#include <string>
 #include <type_traits>
 
 namespace weft {
@@ -114,10 +115,15 @@ class PartialBuffer {
 
 /// How a TaskSystem builds its own arena (TaskSystem::Settings).
 struct TaskSystemSettings {
-  int threadCount = 0;  ///< threads incl. the caller; 0 = std::thread::hardware_concurrency(),
-                        ///< 1 = serial reference (inline, no TBB). More threads than cores only
+  int threadCount = 0;  ///< threads incl. the caller, 0 … kMaxThreadCount; 0 = the machine's
+                        ///< cores, 1 = serial reference (inline, no TBB). More than the cores only
                         ///< helps if the host raised tbb::global_control::max_allowed_parallelism.
+  /// The most threads a TaskSystem takes (per-worker scratch is sized by the count).
+  static constexpr int kMaxThreadCount = 1024;
 };
+
+/// Empty when `settings` are valid; otherwise what is wrong, naming the field and the fix.
+std::string validate(const TaskSystemSettings& settings);
 
 /// Runs deterministic parallel loops over fixed blocks inside a oneTBB task_arena (or serially).
 class TaskSystem {
@@ -130,7 +136,8 @@ class TaskSystem {
   using Settings = TaskSystemSettings;
 
   /// Creates an arena of settings.threadCount slots (none in serial mode). Worker threads come
-  /// from oneTBB's pool on first use; no thread is created here.
+  /// from oneTBB's pool on first use; no thread is created here. Settings that validate()
+  /// refuses give the serial reference (check them first to report the mistake).
   explicit TaskSystem(Settings settings = {});
 
   /// Runs on the caller's arena, which it does not own and which must outlive this object;
