@@ -1,5 +1,7 @@
 #include "ClothSettingsValidation.h"
 
+#include <weft/engine/InputLimits.h>
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -44,9 +46,85 @@ std::string checkHardSubstepThreshold(const char* field, Real value, const char*
   return text.str();
 }
 
+// Every material, spring and mass value of `settings` within kMaxMaterialValue (signs, NaN and
+// infinity have their own checks and messages).
+std::string magnitudeProblem(const ClothSettings& settings) {
+  const ClothMaterial& m = settings.material;
+  const MassSpringMaterial& s = settings.springs;
+  const struct {
+    const char* field;
+    Real value;
+    const char* unit;
+  } fields[] = {
+      {"material.arealDensity", m.arealDensity, "kg/m²"},
+      {"material.warpStretchStiffness", m.warpStretchStiffness, "N/m"},
+      {"material.weftStretchStiffness", m.weftStretchStiffness, "N/m"},
+      {"material.shearStiffness", m.shearStiffness, "N/m"},
+      {"material.bendingStiffness", m.bendingStiffness, "N·m"},
+      {"material.warpRestScale", m.warpRestScale, ""},
+      {"material.weftRestScale", m.weftRestScale, ""},
+      {"material.stretchDamping", m.stretchDamping, "N·s/m"},
+      {"material.shearDamping", m.shearDamping, "N·s/m"},
+      {"material.bendingDamping", m.bendingDamping, "N·m·s"},
+      {"material.airDrag", m.airDrag, "N·s/m³"},
+      {"material.thickness", m.thickness, "m"},
+      {"material.friction", m.friction, ""},
+      {"springs.structuralStiffness", s.structuralStiffness, "N/m"},
+      {"springs.shearStiffness", s.shearStiffness, "N/m"},
+      {"springs.flexionStiffness", s.flexionStiffness, "N/m"},
+      {"springs.structuralDamping", s.structuralDamping, "N·s/m"},
+      {"springs.shearDamping", s.shearDamping, "N·s/m"},
+      {"springs.flexionDamping", s.flexionDamping, "N·s/m"},
+  };
+  auto tooLarge = [](const std::string& field, Real value, const char* unit) {
+    std::ostringstream text;
+    text << "cloth settings: " << field << " = " << value << (*unit ? " " : "") << unit
+         << " is above " << kMaxMaterialValue
+         << " (kMaxMaterialValue), the largest value whose products the solver's arithmetic "
+            "carries; give a physical value (a stiffer cloth is better made with "
+            "material.strainLimit)";
+    return text.str();
+  };
+  for (const auto& field : fields) {
+    if (std::isfinite(field.value) && field.value > kMaxMaterialValue) {
+      return tooLarge(field.field, field.value, field.unit);
+    }
+  }
+  for (std::size_t i = 0; i < settings.vertexMasses.size(); ++i) {
+    const Real mass = settings.vertexMasses[i];
+    if (std::isfinite(mass) && mass > kMaxMaterialValue) {
+      return tooLarge("vertexMasses[" + std::to_string(i) + "]", mass, "kg");
+    }
+  }
+  return {};
+}
+
+
+// The first vertex that `settings`' placement puts beyond kMaxCoordinate.
+std::string placementProblem(const ClothModel& model, const ClothSettings& settings) {
+  if (!settings.translation.allFinite() || !settings.rotation.allFinite()) return {};
+  for (Index i = 0; i < model.vertexCount(); ++i) {
+    const Vec3 x = settings.rotation * model.restPositions()[i] + settings.translation;
+    if (!(x.cwiseAbs().maxCoeff() > kMaxCoordinate)) continue;
+    std::ostringstream text;
+    text << "cloth settings: translation (" << settings.translation.x() << ", "
+         << settings.translation.y() << ", " << settings.translation.z() << ") m puts vertex " << i
+         << " at (" << x.x() << ", " << x.y() << ", " << x.z() << ") m, beyond the "
+         << kMaxCoordinate
+         << " m a coordinate may have (kMaxCoordinate, where doubles still resolve 0.1 nm); keep "
+            "the simulation near the origin (move the origin with the player)";
+    return text.str();
+  }
+  return {};
+}
+
 }  // namespace
 
 std::string validateClothSettings(const ClothModel* model, const ClothSettings& settings) {
+  if (std::string problem = magnitudeProblem(settings); !problem.empty()) return problem;
+  if (model) {
+    if (std::string problem = placementProblem(*model, settings); !problem.empty()) return problem;
+  }
   if (!model) return "ClothModel is null: build one with ClothModel::grid() or fromMesh()";
   const ClothMaterial& m = settings.material;
   const MassSpringMaterial& s = settings.springs;

@@ -5,8 +5,6 @@
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
-#include <cstdio>
-#include <cstdlib>
 #include <cmath>
 
 namespace weft {
@@ -289,31 +287,13 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   const bool pairs = m_planner.pairsNeeded(m_space, m_stepping, selfNeeded, selfSkipped);
   m_detector.detect(m_space, m_colliders, m_solveImpulses, m_constrainedCollider, pairs,
                     m_contactMargin, m_contacts, counts);
+  m_solvedPositions = m_space.x;
   const ProjectionReport projected =
       m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
-  Real strainAfterProject = 0;
-  for (std::size_t e = 0; e < m_space.edges.size(); ++e) {
-    strainAfterProject = std::max(strainAfterProject, (m_space.x[m_space.edges[e][1]] - m_space.x[m_space.edges[e][0]]).norm() / m_space.restLengths[e] - 1);
-  }
-  const ImpactReport impacts = m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs);
-  if (std::getenv("WEFT_DEBUG")) {
-    Real strainAfter = 0;
-    for (std::size_t e = 0; e < m_space.edges.size(); ++e) {
-      strainAfter = std::max(strainAfter, (m_space.x[m_space.edges[e][1]] - m_space.x[m_space.edges[e][0]]).norm() / m_space.restLengths[e] - 1);
-    }
-    Real faceDepth = 0;
-    for (std::size_t c = 0; c < m_contacts.firstPair; ++c) {
-      const Contact& contact = m_contacts.contacts[c];
-      if (contact.kind != ContactKind::FaceCollider) continue;
-      Vec3Array copy = m_space.x, vcopy = m_space.v;
-      Vec3 normal;
-      faceDepth = std::max(faceDepth, pushFaceOut(m_contacts.cores[contact.core], contact.normal, m_colliders[contact.collider].end.pose, {contact.vertices[0], contact.vertices[1], contact.vertices[2]}, m_space.inverseMass, copy, vcopy, 1 / h, normal));
-    }
-    std::fprintf(stderr, "end face depth %.3e selfimpacts %u\n", faceDepth, impacts.impacts);
-    std::fprintf(stderr, "substep t=%.4f contacts %zu (pairs %zu) project it %d over %u viol %u strain %.4f -> impacts %u zones %u frozen %u collider %u strain %.4f\n",
-                 t, m_contacts.size(), m_contacts.size() - m_contacts.firstPair, projected.iterations, projected.edgesOverLimit, projected.contactsViolated,
-                 strainAfterProject, impacts.impacts, impacts.impactZones, impacts.frozenVertices, impacts.colliderCorrections, strainAfter);
-  }
+  const ImpactReport impacts =
+      m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs,
+                        DetectedPairs{&m_detector.featurePairs(), m_solvedPositions,
+                                      m_detector.pairMargin()});
   m_space.scatter();
 
   // What the substep did.

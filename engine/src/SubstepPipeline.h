@@ -76,6 +76,7 @@ class SubstepPipeline {
   std::vector<char> m_stepping;                  // per cloth: steps this frame
   std::vector<char> m_yanked;                    // per cloth: its pins make every substep hard
   std::vector<Real> m_solveImpulses;             // per vertex, m/s
+  Vec3Array m_solvedPositions;                   // x after the solve (the detection's end)
   std::vector<Index> m_constrainedCollider;      // per vertex, kInvalidIndex: none
   std::vector<Real> m_startStrain, m_startKinetic;  // per cloth, at the frame start
   std::vector<IntegratorReport> m_reports;       // per cloth, this attempt

@@ -1,9 +1,9 @@
-// A heavy cloth lying on a light one, the two being separate cloths of one World (issue 9, the
-// cloth–cloth variant of stress scene 9): the contact between them is resolved by
-// ClothClothCollision after each cloth has stepped, which hands the heavy side's momentum to the
-// light vertices under it (strain 16.6 here before the pass held its pairs inside a strain
-// limiter). The light sheet must stay within its strain limit (+ 1 %), with no intersection and
-// a finite state; each cloth keeps its own limit; the result is the same on one and two threads.
+// A heavy cloth lying on a light one, the two being separate cloths of one World (the
+// cloth–cloth variant of stress scene 9): the contact between them hands the heavy side's
+// momentum to the light vertices under it, and the projection must satisfy the pairs and both
+// cloths' strain limits together. The light sheet must stay within its strain limit (+ 1 %), with
+// no intersection and a finite state; each cloth keeps its own limit; the result is the same on
+// one and two threads.
 #include "ContactTestSupport.h"
 
 #include <weft/collision/Plane.h>

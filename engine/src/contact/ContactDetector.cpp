@@ -295,7 +295,8 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
 void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
   Real maxThickness = 0;
   for (const ContactOwner& owner : space.owners) maxThickness = std::max(maxThickness, owner.thickness);
-  m_features.find(space, space.startX, space.x, kPairReach * maxThickness);
+  m_pairMargin = kPairReach * maxThickness;
+  m_features.find(space, space.startX, space.x, m_pairMargin);
   const auto& vertexTriangle = m_features.vertexTriangle();
   const auto& edgeEdgePairs = m_features.edgeEdge();
   const Index vertexTriangleCount = Index(vertexTriangle.size());

@@ -90,6 +90,10 @@ class ContactDetector {
               std::span<const Real> solveImpulses, std::span<const Index> constrainedCollider,
               bool pairs, Real margin, ContactSet& set, DetectionCounts& counts);
 
+  /// The feature pairs of the last detect() (over x₀ → x with pairMargin()).
+  const FeaturePairs& featurePairs() const { return m_features; }
+  Real pairMargin() const { return m_pairMargin; }
+
   /// Broad-phase nodes refit and kept since the last call.
   Bvh::RefitCounts takeRefitCounts() { return m_features.takeRefitCounts(); }
 
@@ -109,6 +113,7 @@ class ContactDetector {
 
   TaskSystem* m_tasks = nullptr;
   bool m_skip = true;
+  Real m_pairMargin = 0;  // of the last detectPairs()
   FeaturePairs m_features;
   std::vector<Index> m_near;  // colliders near the cloth this pass
   struct FoundContact {

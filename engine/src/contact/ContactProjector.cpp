@@ -5,8 +5,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <cstdio>
-#include <cstdlib>
 
 namespace weft {
 namespace {
@@ -104,42 +102,15 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
       m_lastOutside[c] = colliders[contact.collider].carry(space.startX[contact.vertices[0]]);
     }
   }
-  const Real inverseStep = 1 / h;
   for (int iteration = 0;; ++iteration) {
     const bool backward = iteration % 2 == 1;
     m_frictionOn = iteration < kFrictionSweeps;
     m_followTheLeader = iteration < kFollowTheLeaderSweeps;
-    const Index over = sweepEdges(space, inverseStep, settings.strainTolerance, backward);
+    const Index over = sweepEdges(space, settings.strainTolerance, backward);
     const Index violated =
         sweepContacts(space, set, colliders, h, settings.contactTolerance, backward);
     report.edgesOverLimit = over;
     report.contactsViolated = violated;
-    if (std::getenv("WEFT_DEBUG2") && (iteration < 3 || iteration % 32 == 0 || iteration > 125)) {
-      int kinds[4] = {0, 0, 0, 0};
-      Real worst = 0;
-      for (std::size_t c = 0; c < set.size(); ++c) {
-        const Contact& contact = set.contacts[c];
-        if (contact.kind == ContactKind::VertexFace || contact.kind == ContactKind::EdgeEdge) {
-          Vec3 gap = Vec3::Zero();
-          for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
-          const Real short_ = contact.separation - contact.normal.dot(gap);
-          if (short_ > 3e-5) { kinds[int(contact.kind)]++; worst = std::max(worst, short_); }
-        }
-      }
-      std::fprintf(stderr, "   it %d over %u viol %u  vf %d ee %d worst %.2e (set %zu)\n", iteration, over, violated, kinds[2], kinds[3], worst, set.size());
-      if (iteration > 126) {
-        int shown = 0;
-        for (std::size_t c = set.firstPair; c < set.size() && shown < 12; ++c) {
-          const Contact& contact = set.contacts[c];
-          Vec3 gap = Vec3::Zero(), gap0 = Vec3::Zero();
-          for (int k = 0; k < 4; ++k) { gap += contact.weights[k] * space.x[contact.vertices[k]]; gap0 += contact.weights[k] * space.startX[contact.vertices[k]]; }
-          const Real short_ = contact.separation - contact.normal.dot(gap);
-          if (short_ < 1e-3) continue;
-          ++shown;
-          std::fprintf(stderr, "      c%zu kind %d v %u %u %u %u w %.2f %.2f %.2f %.2f sep %.2e now %.2e start %.2e |gap0| %.2e resting %d pushed %.2e\n", c, int(contact.kind), contact.vertices[0], contact.vertices[1], contact.vertices[2], contact.vertices[3], contact.weights[0], contact.weights[1], contact.weights[2], contact.weights[3], contact.separation, contact.normal.dot(gap), contact.normal.dot(gap0), gap0.norm(), contact.resting, m_pushed[c]);
-        }
-      }
-    }
     if (over == 0 && violated == 0) break;
     report.iterations = iteration + 1;
     if (report.iterations == settings.maxIterations) {
@@ -155,13 +126,13 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   }
   // The projection's whole displacement becomes the velocity's change, so v stays the substep's
   // average velocity (x − x₀) / h; then contacts keep no velocity into each other.
+  const Real inverseStep = 1 / h;
   for (Index i = 0; i < space.vertexCount(); ++i) space.v[i] += (space.x[i] - m_solved[i]) * inverseStep;
-  report.colliderContacts = finish(space, set, colliders, h, supports);
+  report.colliderContacts = finish(space, set, colliders, supports);
   return report;
 }
 
-Index ContactProjector::sweepEdges(ContactSpace& space, Real inverseStep, Real tolerance,
-                                   bool backward) {
+Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool backward) {
   const Index edgeCount = Index(space.edges.size());
   Index over = 0;
   // The tethers first: each moves its vertex only (the anchor is a pin).
@@ -240,7 +211,7 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
         break;
       case ContactKind::VertexFace:
       case ContactKind::EdgeEdge:
-        depth = projectPair(space, c, contact, h);
+        depth = projectPair(space, c, contact);
         break;
     }
     // A contact counts while it still moves its vertices (pushed out, or friction's stick).
@@ -345,8 +316,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   return std::max(depth, change.norm());
 }
 
-Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact,
-                                   Real h) {
+Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact) {
   const auto [inverseMass, weight] = pairInverseMass(contact, space.inverseMass);
   if (!(weight > 0)) return 0;
   Vec3 gap = Vec3::Zero();
@@ -393,7 +363,7 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
 }
 
 Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,
-                               std::span<const ColliderFrame> colliders, Real h,
+                               std::span<const ColliderFrame> colliders,
                                std::vector<FaceSupport>& supports) {
   supports.clear();
   Index onColliders = 0;

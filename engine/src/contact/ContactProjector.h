@@ -84,7 +84,7 @@ class ContactProjector {
  private:
   // One Gauss–Seidel sweep over the edges over their limit; returns how many were over
   // limit + tolerance before their correction.
-  Index sweepEdges(ContactSpace& space, Real inverseStep, Real tolerance, bool backward);
+  Index sweepEdges(ContactSpace& space, Real tolerance, bool backward);
   // One sweep over the contacts; returns how many were violated beyond tolerance.
   Index sweepContacts(ContactSpace& space, const ContactSet& set,
                       std::span<const ColliderFrame> colliders, Real h, Real tolerance,
@@ -93,10 +93,10 @@ class ContactProjector {
                      const ColliderFrame& collider, Real h);
   Real projectFace(ContactSpace& space, std::size_t index, const Contact& contact,
                    const ContactSet& set, const ColliderFrame& collider, Real h);
-  Real projectPair(ContactSpace& space, std::size_t index, const Contact& contact, Real h);
+  Real projectPair(ContactSpace& space, std::size_t index, const Contact& contact);
   // The final velocity pass and the supports (see the file comment).
   Index finish(ContactSpace& space, const ContactSet& set, std::span<const ColliderFrame> colliders,
-               Real h, std::vector<FaceSupport>& supports);
+               std::vector<FaceSupport>& supports);
 
   // Per contact of the set being projected.
   std::vector<Real> m_pushed;     // m, normal displacement the projection gave it

@@ -8,12 +8,13 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <cstdio>
-#include <cstdlib>
 
 namespace weft {
 namespace {
 
+// The swept test's tolerance is 1 µm: broad-phase boxes inflated by a little more (m) catch
+// every pair it reports.
+constexpr Real kSweptInflate = 2 * kDefaultContactTolerance;
 // Passes of impulse-based continuous detection before the impact zones take over.
 constexpr int kImpulsePasses = 6;
 // Merging passes of the impact zones before the last resort freezes what still collides.
@@ -72,7 +73,6 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
                                                contact.vertices[2]},
                                               space.inverseMass, space.x, space.v, 0, normal));
     }
-    if (std::getenv("WEFT_DEBUG")) std::fprintf(stderr, "  face sweep %d deepest %.3e\n", sweep, deepest);
     if (!(deepest > kSettledDepth)) break;
   }
   Real thickness = 0;
@@ -113,17 +113,6 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
       moved = true;
     }
     corrected += moved;
-  }
-  if (std::getenv("WEFT_DEBUG")) {
-    Real deepest = 0;
-    for (std::size_t c = 0; c < set.firstPair; ++c) {
-      const Contact& contact = set.contacts[c];
-      if (contact.kind != ContactKind::FaceCollider) continue;
-      Vec3Array copy = space.x, vcopy = space.v;
-      Vec3 normal;
-      deepest = std::max(deepest, pushFaceOut(set.cores[contact.core], contact.normal, colliders[contact.collider].end.pose, {contact.vertices[0], contact.vertices[1], contact.vertices[2]}, space.inverseMass, copy, vcopy, 1 / h, normal));
-    }
-    std::fprintf(stderr, "  after vertex pass: face depth %.3e, corrected %u\n", deepest, corrected);
   }
   return corrected;
 }
@@ -206,8 +195,6 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   const Vec3Array& start = space.startX;
   const Index n = space.vertexCount();
   for (Index i = 0; i < n; ++i) m_end[i] = start[i] + h * m_velocity[i];
-  // The swept test's tolerance is 1 µm: boxes inflated by a little more catch all it reports.
-  const Real inflate = 2 * kDefaultContactTolerance;
   // Only pairs with a vertex whose end moved since the last test, or that was in one of its
   // hits, can test differently: the others would test exactly as then, negative.
   bool any = false;
@@ -219,9 +206,17 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   }
   m_impacts.clear();
   if (!any) return false;
-  m_features.find(space, start, m_end, inflate, &m_dirty);
-  const auto& vertexTriangle = m_features.vertexTriangle();
-  const auto& edgeEdge = m_features.edgeEdge();
+  // The first test may take the detection's feature pairs when they hold every pair this one
+  // would find (see resolve()); later ones restrict the search to the dirty vertices.
+  const FeaturePairs* features = &m_features;
+  if (m_candidates) {
+    features = m_candidates;
+    m_candidates = nullptr;
+  } else {
+    m_features.find(space, start, m_end, kSweptInflate, &m_dirty);
+  }
+  const auto& vertexTriangle = features->vertexTriangle();
+  const auto& edgeEdge = features->edgeEdge();
   const Index vertexTriangleCount = Index(vertexTriangle.size());
   const Index total = vertexTriangleCount + Index(edgeEdge.size());
   auto test = [&](Index pair, Impact& impact) -> bool {
@@ -361,12 +356,25 @@ void ImpactResolver::rigidifyZones(const ContactSpace& space) {
 }
 
 ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
-                                     std::span<const ColliderFrame> colliders, Real h, bool pairs) {
+                                     std::span<const ColliderFrame> colliders, Real h, bool pairs,
+                                     const DetectedPairs& detected) {
   WEFT_PROFILE_ZONE("impacts");
   ImpactReport report;
   m_colliders = colliders;
   report.colliderCorrections = keepOutOfColliders(space, set, colliders, h);
   if (!pairs) return report;
+  // The detection's feature pairs were found over x₀ → x₁ with a margin R; this stage's swept
+  // boxes over x₀ → x₂ with a margin δ lie within those boxes grown by the largest move d from x₁
+  // to x₂, so every pair it would find is among them when 2d + δ ≤ R. Then the first swept test
+  // runs over them instead of a broad phase of its own (the extra pairs test negative).
+  m_candidates = nullptr;
+  if (detected.features && !detected.endPositions.empty()) {
+    Real moved = 0;
+    for (Index i = 0; i < space.vertexCount(); ++i) {
+      moved = std::max(moved, (space.x[i] - detected.endPositions[i]).cwiseAbs().maxCoeff());
+    }
+    if (2 * moved + kSweptInflate <= detected.margin) m_candidates = detected.features;
+  }
   const Index n = space.vertexCount();
   const Vec3Array& start = space.startX;
   for (Index i = 0; i < n; ++i) m_velocity[i] = (space.x[i] - start[i]) / h;

@@ -40,6 +40,14 @@
 
 namespace weft {
 
+/// The feature pairs the detection found this substep, over x₀ → `endPositions` with `margin`
+/// (m): the impact stage's first swept test reuses them when the stages between moved little.
+struct DetectedPairs {
+  const FeaturePairs* features = nullptr;
+  std::span<const Vec3> endPositions;
+  Real margin = 0;
+};
+
 /// What one resolve() did.
 struct ImpactReport {
   Index colliderCorrections = 0;  ///< vertices put back out of a collider
@@ -60,7 +68,8 @@ class ImpactResolver {
   /// run the swept tests between cloth features (false when no cloth can touch itself or
   /// another this substep).
   ImpactReport resolve(ContactSpace& space, const ContactSet& set,
-                       std::span<const ColliderFrame> colliders, Real h, bool pairs);
+                       std::span<const ColliderFrame> colliders, Real h, bool pairs,
+                       const DetectedPairs& detected = {});
 
   Bvh::RefitCounts takeRefitCounts() { return m_features.takeRefitCounts(); }
 
@@ -87,6 +96,7 @@ class ImpactResolver {
   TaskSystem* m_tasks = nullptr;
   bool m_skip = true;
   FeaturePairs m_features;
+  const FeaturePairs* m_candidates = nullptr;  // the detection's, for the first swept test
   std::span<const ColliderFrame> m_colliders;
   std::vector<Index> m_near;                 // colliders near the cloth this substep
   std::unique_ptr<PerWorker<std::vector<FoundImpact>>> m_workerImpacts;
