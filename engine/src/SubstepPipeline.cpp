@@ -83,7 +83,10 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
                                 std::span<const ColliderSource> colliders, Real t, Real frameDt,
                                 const StepPlan& plan, StepStats& stats) {
   if (cloths.empty()) return;
-  if (!m_space.builtFor(cloths)) rebuild(cloths);
+  if (m_clothsChanged || !m_space.builtFor(cloths)) {
+    rebuild(cloths);
+    m_clothsChanged = false;
+  }
   // The colliders at the frame start, and their motions for the substeps.
   m_frameColliders.resize(colliders.size());
   m_colliders.resize(colliders.size());

@@ -51,6 +51,10 @@ class SubstepPipeline {
   void stepFrame(std::span<Cloth* const> cloths, std::span<const ColliderSource> colliders, Real t,
                  Real frameDt, const StepPlan& plan, StepStats& stats);
 
+  /// The world created or destroyed a cloth: the next frame rebuilds the contact space. (A new
+  /// cloth may live at a destroyed one's address, so comparing pointers cannot tell.)
+  void clothsChanged() { m_clothsChanged = true; }
+
  private:
   // The substeps of one attempt at the frame; the health check that failed, or None.
   HealthFailure runSubsteps(Real t, Real frameDt, Index substeps, StepStats& stats);
@@ -62,6 +66,7 @@ class SubstepPipeline {
 
   TaskSystem* m_tasks;
   bool m_skipStages;
+  bool m_clothsChanged = true;
   ContactSpace m_space;
   StagePlanner m_planner;
   ContactDetector m_detector;

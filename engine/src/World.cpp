@@ -246,6 +246,7 @@ Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
   Result<std::unique_ptr<Cloth>> cloth =
       Cloth::create(std::move(model), settings, m_settings, m_tasks);
   if (!cloth.ok()) return cloth.error();
+  m_pipeline->clothsChanged();
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     if (!m_slots[k]->cloth) {
       m_slots[k]->cloth = std::move(cloth.value());
@@ -326,6 +327,7 @@ Status World::destroyCloth(ClothId id) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("destroyCloth", id);
   slot->cloth.reset();
+  m_pipeline->clothsChanged();
   slot->attachments.clear();
   ++slot->generation;  // every copy of the old handle is now stale
   return Status::success();
