@@ -18,6 +18,9 @@ constexpr Real kRefitMotionPerThickness = 0.02;
 // the solve is a contact of the projection: one iteration moves a vertex far less than that, and
 // the impact stage still catches what is farther.
 constexpr Real kColliderMarginPerEdge = 0.5;
+// Rounds of projection and impacts after the first, while the impact pass leaves an edge over
+// its limit.
+constexpr int kStrainRounds = 2;
 
 // Adds the counters the substeps of an attempt collect to the frame's statistics.
 void addSubstepCounters(const StepStats& from, StepStats& to) {
@@ -291,12 +294,28 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   m_detector.detect(m_space, m_colliders, m_solveImpulses, m_constrainedCollider, pairs,
                     m_contactMargin, m_contacts, counts);
   m_solvedPositions = m_space.x;
-  const ProjectionReport projected =
+  ProjectionReport projected =
       m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
-  const ImpactReport impacts =
+  ImpactReport impacts =
       m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs,
                         DetectedPairs{&m_detector.featurePairs(), m_solvedPositions,
                                       m_detector.pairMargin()});
+  // The impact pass has the last word and may stretch edges the projection had limited (a
+  // vertex held at its start while its neighbours moved): project and resolve again, a few
+  // rounds at most, while an edge stays over its limit.
+  for (int round = 0; round < kStrainRounds && impacts.impacts + impacts.frozenVertices > 0 &&
+                      m_space.edgesOverLimit(m_projection.strainTolerance) > 0;
+       ++round) {
+    const ProjectionReport again =
+        m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
+    projected.iterations += again.iterations;
+    projected.edgesOverLimit = again.edgesOverLimit;
+    const ImpactReport more = m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs);
+    impacts.impacts += more.impacts;
+    impacts.impactZones += more.impactZones;
+    impacts.frozenVertices = more.frozenVertices;
+    impacts.colliderCorrections += more.colliderCorrections;
+  }
   m_space.scatter();
 
   // What the substep did.

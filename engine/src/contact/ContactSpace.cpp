@@ -139,6 +139,16 @@ bool ContactSpace::builtFor(std::span<Cloth* const> cloths) const {
   return std::equal(cloths.begin(), cloths.end(), m_cloths.begin(), m_cloths.end());
 }
 
+Index ContactSpace::edgesOverLimit(Real tolerance) const {
+  Index over = 0;
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const Index a = edges[e][0], b = edges[e][1];
+    if (inverseMass[a] == 0 && inverseMass[b] == 0) continue;
+    over += (x[b] - x[a]).norm() > longest[e] + tolerance * restLengths[e];
+  }
+  return over;
+}
+
 void ContactSpace::gather() {
   for (std::size_t c = 0; c < m_cloths.size(); ++c) {
     const Cloth& cloth = *m_cloths[c];

@@ -31,6 +31,9 @@ class ContactSpace {
   void build(std::span<Cloth* const> cloths);
   /// True when the space was built for exactly these cloths.
   bool builtFor(std::span<Cloth* const> cloths) const;
+  /// Edges longer than their limit by more than `tolerance` times their rest length, among
+  /// those with a free end.
+  Index edgesOverLimit(Real tolerance) const;
 
   /// Copies positions and velocities of every cloth into x and v.
   void gather();
