@@ -13,10 +13,10 @@ namespace {
 // projection (its normal velocity is made inelastic): the projection leaves contacts at exactly
 // the thickness, a body's curvature a little beyond.
 constexpr Real kOnSurfaceShell = 0.01;
-// Sweeps in which friction acts: friction holds what the solve moved, and the sweeps after it
-// satisfy the strain limit and the separations, which friction must not resist (a cloth pulled
-// over a body at its limit slides on it, whatever the friction).
-constexpr int kFrictionSweeps = 1;
+// Friction acts in every sweep, its accumulated correction bounded by the contact's budget, so
+// the sweeps that satisfy the strain limit and the separations cannot undo what it holds (a
+// towel resting on a rod by its faces would creep along it).
+constexpr int kFrictionSweeps = std::numeric_limits<int>::max();
 // Sweeps in which the edges follow the leader (only the end farther from the pins moves): the first
 // brings a hanging chain within its limit from the pins down in one pass; the later ones share
 // each correction by mass, which lets a load from the far side (a body pushing the cloth's middle)
