@@ -40,9 +40,7 @@ Real thicknessOf(const ContactSpace& space, Index vertex) {
 void ContactDetector::build(const ContactSpace& space, TaskSystem* tasks) {
   m_tasks = tasks;
   m_features.build(space, tasks);
-  if (m_tasks && !m_tasks->isSerial() && !m_workerContacts) {
-    m_workerContacts = std::make_unique<PerWorker<std::vector<FoundContact>>>(*m_tasks);
-  }
+  m_pairFilter.build(tasks);
 }
 
 void ContactDetector::selectNear(const ContactSpace& space,
@@ -409,37 +407,7 @@ void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
     return found;
   };
   WEFT_PROFILE_ZONE("narrow phase");
-  if (!m_workerContacts || total <= kGrainFeaturePairs) {
-    Contact contact;
-    for (Index pair = 0; pair < total; ++pair) {
-      contact = Contact{};
-      if (test(pair, contact)) set.contacts.push_back(contact);
-    }
-    return;
-  }
-  m_workerContacts->forEach([](std::vector<FoundContact>& found) { found.clear(); });
-  m_tasks->parallelFor(total, kGrainFeaturePairs, [&](Index begin, Index end, int worker) {
-    std::vector<FoundContact>& found = (*m_workerContacts)[worker];
-    Contact contact;
-    for (Index pair = begin; pair < end; ++pair) {
-      contact = Contact{};
-      if (test(pair, contact)) found.push_back({pair, contact});
-    }
-  });
-  // Which worker found which contact depends on timing; the pair index restores the serial order.
-  m_found.clear();
-  m_workerContacts->forEach([this](std::vector<FoundContact>& found) {
-    m_found.insert(m_found.end(), found.begin(), found.end());
-  });
-  std::sort(m_found.begin(), m_found.end(),
-            [](const FoundContact& a, const FoundContact& b) { return a.pair < b.pair; });
-  for (const FoundContact& found : m_found) set.contacts.push_back(found.contact);
-  // Room for all in every worker's list: allocation follows the number of contacts, never the
-  // timing of the threads.
-  const std::size_t count = m_found.size();
-  m_workerContacts->forEach([count](std::vector<FoundContact>& found) {
-    if (found.capacity() < count) found.reserve(count);
-  });
+  m_pairFilter.run(total, kGrainFeaturePairs, test, set.contacts);
 }
 
 }  // namespace weft

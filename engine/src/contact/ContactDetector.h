@@ -25,6 +25,7 @@
 #include "contact/ContactSet.h"
 #include "contact/ContactSpace.h"
 #include "contact/FeaturePairs.h"
+#include "contact/OrderedPairFilter.h"
 
 #include <weft/threading/PerWorker.h>
 #include <weft/threading/TaskSystem.h>
@@ -116,12 +117,7 @@ class ContactDetector {
   Real m_pairMargin = 0;  // of the last detectPairs()
   FeaturePairs m_features;
   std::vector<Index> m_near;  // colliders near the cloth this pass
-  struct FoundContact {
-    Index pair;
-    Contact contact;
-  };
-  std::unique_ptr<PerWorker<std::vector<FoundContact>>> m_workerContacts;
-  std::vector<FoundContact> m_found;
+  OrderedPairFilter<Contact> m_pairFilter;
   std::vector<Index> m_meshTriangles;
   std::vector<std::pair<Index, Index>> m_meshEdges;
   std::vector<FaceCore> m_bodyCores;

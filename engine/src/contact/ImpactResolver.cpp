@@ -43,9 +43,7 @@ Index findRoot(std::vector<Index>& parent, Index vertex) {
 void ImpactResolver::build(const ContactSpace& space, TaskSystem* tasks) {
   m_tasks = tasks;
   m_features.build(space, tasks);
-  if (m_tasks && !m_tasks->isSerial() && !m_workerImpacts) {
-    m_workerImpacts = std::make_unique<PerWorker<std::vector<FoundImpact>>>(*m_tasks);
-  }
+  m_pairFilter.build(tasks);
   const Index n = space.vertexCount();
   m_zoneParent.resize(n);
   m_velocity.resize(n);
@@ -54,7 +52,7 @@ void ImpactResolver::build(const ContactSpace& space, TaskSystem* tasks) {
 }
 
 Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& set,
-                                         std::span<const ColliderFrame> colliders, Real h) {
+                                         std::span<const ColliderFrame> colliders) {
   m_near.clear();
   if (colliders.empty()) return 0;
   // The faces, swept until no point moves more than round-off (neighbouring faces share
@@ -263,32 +261,7 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
     return true;
   };
   WEFT_PROFILE_ZONE("swept tests");
-  if (!m_workerImpacts || total <= kGrainFeaturePairs) {
-    Impact impact;
-    for (Index pair = 0; pair < total; ++pair) {
-      if (test(pair, impact)) m_impacts.push_back(impact);
-    }
-  } else {
-    m_workerImpacts->forEach([](std::vector<FoundImpact>& found) { found.clear(); });
-    m_tasks->parallelFor(total, kGrainFeaturePairs, [&](Index begin, Index end, int worker) {
-      std::vector<FoundImpact>& found = (*m_workerImpacts)[worker];
-      Impact impact;
-      for (Index pair = begin; pair < end; ++pair) {
-        if (test(pair, impact)) found.push_back({pair, impact});
-      }
-    });
-    m_found.clear();
-    m_workerImpacts->forEach([this](std::vector<FoundImpact>& found) {
-      m_found.insert(m_found.end(), found.begin(), found.end());
-    });
-    std::sort(m_found.begin(), m_found.end(),
-              [](const FoundImpact& a, const FoundImpact& b) { return a.pair < b.pair; });
-    for (const FoundImpact& found : m_found) m_impacts.push_back(found.impact);
-    const std::size_t count = m_found.size();
-    m_workerImpacts->forEach([count](std::vector<FoundImpact>& found) {
-      if (found.capacity() < count) found.reserve(count);
-    });
-  }
+  m_pairFilter.run(total, kGrainFeaturePairs, test, m_impacts);
   // The next test needs only the vertices whose ends move from here, and those of the hits.
   m_testedEnd = m_end;
   std::fill(m_dirty.begin(), m_dirty.end(), char(0));
@@ -361,7 +334,7 @@ ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
   WEFT_PROFILE_ZONE("impacts");
   ImpactReport report;
   m_colliders = colliders;
-  report.colliderCorrections = keepOutOfColliders(space, set, colliders, h);
+  report.colliderCorrections = keepOutOfColliders(space, set, colliders);
   if (!pairs) return report;
   // The detection's feature pairs were found over x₀ → x₁ with a margin R; this stage's swept
   // boxes over x₀ → x₂ with a margin δ lie within those boxes grown by the largest move d from x₁

@@ -30,6 +30,7 @@
 #include "contact/ContactSet.h"
 #include "contact/ContactSpace.h"
 #include "contact/FeaturePairs.h"
+#include "contact/OrderedPairFilter.h"
 
 #include <weft/threading/PerWorker.h>
 #include <weft/threading/TaskSystem.h>
@@ -75,18 +76,14 @@ class ImpactResolver {
 
  private:
   struct Impact {
-    std::array<Index, 4> vertices;
-    std::array<Real, 4> weights;
-    Vec3 normal;
+    std::array<Index, 4> vertices{};
+    std::array<Real, 4> weights{};
+    Vec3 normal = Vec3::Zero();
     Real thickness = 0;
     Real friction = 0;
   };
-  struct FoundImpact {
-    Index pair;
-    Impact impact;
-  };
   Index keepOutOfColliders(ContactSpace& space, const ContactSet& set,
-                           std::span<const ColliderFrame> colliders, Real h);
+                           std::span<const ColliderFrame> colliders);
   bool findImpacts(const ContactSpace& space, Real h);
   void applyImpulse(const Impact& impact, Real targetNormalSpeed, const ContactSpace& space);
   void rigidifyZones(const ContactSpace& space);
@@ -99,8 +96,7 @@ class ImpactResolver {
   const FeaturePairs* m_candidates = nullptr;  // the detection's, for the first swept test
   std::span<const ColliderFrame> m_colliders;
   std::vector<Index> m_near;                 // colliders near the cloth this substep
-  std::unique_ptr<PerWorker<std::vector<FoundImpact>>> m_workerImpacts;
-  std::vector<FoundImpact> m_found;
+  OrderedPairFilter<Impact> m_pairFilter;
   std::vector<Impact> m_impacts;
   Vec3Array m_velocity;                      // v̄ being corrected
   Vec3Array m_end;                           // x₀ + h v̄
