@@ -1,4 +1,4 @@
-// World::step() allocates nothing once a cloth has taken its first step (DESIGN.md §7): the
+// World::step() allocates nothing once a cloth has taken its first step (docs/architecture.md): the
 // matrix pattern, solver scratch and integrator buffers are all sized up front or on first use.
 // Counted by replacing the global operator new for this test binary; counting is switched on
 // only around the steps under test. The replacement also keeps the heap's live and peak bytes
