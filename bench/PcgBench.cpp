@@ -149,8 +149,8 @@ void PcgIteration(benchmark::State& state) {
       state.range(2) == 0 ? PreconditionerKind::MulticolorGaussSeidel : PreconditionerKind::BlockJacobi;
   const Index n = system.matrix.blockRows();
   const double blocks = double(system.matrix.blockCount());
-  const double bytes = blocks * (FilteredPcg::kStoredBlockBytes + sizeof(Index)) +
-                       double(n + 1) * sizeof(Index) + double(n) * FilteredPcg::kStoredBlockBytes +
+  const double bytes = blocks * (sizeof(Mat3) + sizeof(Index)) +
+                       double(n + 1) * sizeof(Index) + double(n) * sizeof(Mat3) +
                        4.0 * double(n) * sizeof(Vec3);
 
   FilteredPcg pcg;

@@ -4,11 +4,11 @@
 // The loop is deliberately trivial: every element (triangle, hinge or spring) asks its pure
 // kernel for its contribution and scatters it through slots precomputed at set-up into the
 // block-sparse matrix. There is no search and no allocation in a step.
-// - Triangles in StiffnessMode::Definite (the implicit solver's) use stretchShear()
-//   (forces/BaraffWitkin.h): stretch, shear and their damping fused in closed form, six 3×3 blocks
-//   per triangle, from constants (√a-scaled weights, rest lengths) stored in the element itself, so
-//   the loop streams through one array. Exact mode (checks, Newton) and hinges and springs go
-//   through conditions (forces/Condition.h) and ElementForces.
+// - Triangles use stretchShear() (forces/BaraffWitkin.h) for forces and for assemblies in
+//   StiffnessMode::Definite (the implicit solver's): stretch, shear and their damping fused in
+//   closed form, from constants (√a-scaled weights, rest lengths) stored in the element itself, so
+//   the loop streams through one array. Assemblies in Exact mode (checks, Newton), hinges and
+//   springs go through conditions (forces/Condition.h) and ElementForces.
 // - One pass per vertex starts every row: gravity, drag and external forces; the isometric
 //   bending force gathered from its stencils; and the row's blocks set to M + h·drag on the
 //   diagonal plus bending's constant Hessian, (h k_d + h² D) K̂ ⊗ I₃, K̂ = Σ_s c_s w_s w_sᵀ summed

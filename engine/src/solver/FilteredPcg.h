@@ -192,9 +192,6 @@ class FilteredPcg {
   /// the thread count) so the summation order, and hence every bit of the result, is too; 256
   /// vertices of the four solver vectors (~24 KB) fit in L1/L2 and amortise a task's overhead.
   static constexpr Index kReductionBlock = 256;
-  /// Bytes of one matrix block as the iterations read it (A's blocks, the packed sweep copies
-  /// and D̃⁻¹), for bandwidth estimates (bench/PcgBench.cpp).
-  static constexpr std::size_t kStoredBlockBytes = sizeof(Mat3);
 
   /// Allocates scratch for vertexCount vertices; solve() then never allocates for that size.
   void resize(Index vertexCount);
