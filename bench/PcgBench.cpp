@@ -12,10 +12,14 @@
 // block and its column index, the row offsets, the preconditioner's n diagonal blocks, and four
 // vectors of n Vec3 (x read and y written by the SpMV, r read and z written by the preconditioner).
 // The Gauss–Seidel iteration (Eisenstat's form) moves the same matrix bytes: its two half-sweeps
-// read every off-diagonal block once and D̃⁻¹ twice. Bandwidth: a STREAM triad a = b + s·c,
+// read every off-diagonal block once and D̃⁻¹ twice (the second read is left out: the bound stays
+// a lower bound). Bandwidth: a STREAM triad a = b + s·c,
 // measured in the same benchmark body right before the solves, with the same thread count, twice:
 // on 3 × 64 MB arrays (memory: larger than the last-level cache) and on arrays the size of the
-// iteration's bytes (the cache level the system fits in). Counters (per benchmark):
+// iteration's bytes (the cache level the system fits in). Each time is the best of several runs,
+// on the wall clock or (argument cpu:1) in CPU seconds of the process, for the triad and the
+// solves alike: on a shared machine the wall clock mostly measures waiting for a core.
+// Counters (per benchmark):
 //   iteration_us   measured time of one PCG iteration (the benchmark's time is the same)
 //   bound_us       bytes / memory triad bandwidth;   ratio = iteration_us / bound_us
 //   cache_bound_us bytes / same-size triad bandwidth; cache_ratio = iteration_us / cache_bound_us
@@ -35,6 +39,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <map>
 #include <memory>
 
@@ -115,13 +120,20 @@ TaskSystem& pcgTasks(int threads) {
   return *entry;
 }
 
-double seconds(std::chrono::steady_clock::duration duration) {
-  return std::chrono::duration<double>(duration).count();
+/// Seconds on the wall clock, or of CPU time used by the process (all its threads): the clock of
+/// a shared machine, where a wall-clock interval mostly measures waiting for a core.
+double now(bool cpuTime) {
+  if (!cpuTime) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  }
+  timespec time{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &time);
+  return double(time.tv_sec) + 1e-9 * double(time.tv_nsec);
 }
 
 /// STREAM triad a = b + s·c over `count` doubles per array on `tasks`: the best of `repeats`
-/// passes, in bytes per second (3 × 8 bytes per element, STREAM's convention).
-double triadBandwidth(std::size_t count, TaskSystem& tasks, int repeats) {
+/// passes, in bytes per second of `now(cpuTime)` (3 × 8 bytes per element, STREAM's convention).
+double triadBandwidth(std::size_t count, TaskSystem& tasks, int repeats, bool cpuTime) {
   static std::vector<double> a, b, c;
   if (a.size() < count) {
     a.assign(count, 1.0);
@@ -131,12 +143,12 @@ double triadBandwidth(std::size_t count, TaskSystem& tasks, int repeats) {
   constexpr Index kGrain = 1 << 14;
   double best = 1e30;
   for (int repeat = 0; repeat < repeats; ++repeat) {
-    const auto start = std::chrono::steady_clock::now();
+    const double start = now(cpuTime);
     tasks.parallelFor(Index(count), kGrain, [&](Index begin, Index end, int) {
       for (Index i = begin; i < end; ++i) a[i] = b[i] + 3.0 * c[i];
     });
     benchmark::ClobberMemory();
-    best = std::min(best, seconds(std::chrono::steady_clock::now() - start));
+    best = std::min(best, now(cpuTime) - start);
   }
   benchmark::DoNotOptimize(a.data());
   return 3.0 * sizeof(double) * double(count) / best;
@@ -147,6 +159,7 @@ void PcgIteration(benchmark::State& state) {
   TaskSystem& tasks = pcgTasks(int(state.range(1)));
   const PreconditionerKind kind =
       state.range(2) == 0 ? PreconditionerKind::MulticolorGaussSeidel : PreconditionerKind::BlockJacobi;
+  const bool cpuTime = state.range(3) != 0;
   const Index n = system.matrix.blockRows();
   const double blocks = double(system.matrix.blockCount());
   const double bytes = blocks * (sizeof(Mat3) + sizeof(Index)) +
@@ -170,23 +183,28 @@ void PcgIteration(benchmark::State& state) {
   // Fixed iteration counts: tolerance 0 never stops before the cap.
   settings.tolerance = 0;
   settings.absoluteTolerance = 0;
-  constexpr int kShort = 5, kLong = 45;
+  constexpr int kShort = 5, kLong = 45, kSolveRepeats = 7;
   const auto timeSolve = [&](int iterations) {
     settings.maxIterations = iterations;
     std::fill(deltaV.begin(), deltaV.end(), Vec3::Zero());
-    const auto start = std::chrono::steady_clock::now();
+    const double start = now(cpuTime);
     const SolveReport report =
         pcg.solve(system.matrix, system.b, system.filter, settings, deltaV, &tasks, system.rowMass);
-    const double elapsed = seconds(std::chrono::steady_clock::now() - start);
+    const double elapsed = now(cpuTime) - start;
     if (report.iterations != iterations) state.SkipWithError("the solve ended before its cap");
     return elapsed;
   };
   double memoryBandwidth = 0, cacheBandwidth = 0, iterationSeconds = 0;
   for (auto _ : state) {
-    memoryBandwidth = triadBandwidth(std::size_t(8) << 20, tasks, 3);  // 3 × 64 MB
-    cacheBandwidth = triadBandwidth(std::size_t(bytes / 24), tasks, 20);
-    const double shortSolve = timeSolve(kShort);
-    const double longSolve = timeSolve(kLong);
+    memoryBandwidth = triadBandwidth(std::size_t(8) << 20, tasks, 3, cpuTime);  // 3 × 64 MB
+    cacheBandwidth = triadBandwidth(std::size_t(bytes / 24), tasks, 20, cpuTime);
+    // The best of several solves of each length, as the triad takes its best pass: on a shared
+    // machine a solve is only ever slowed down.
+    double shortSolve = 1e30, longSolve = 1e30;
+    for (int repeat = 0; repeat < kSolveRepeats; ++repeat) {
+      shortSolve = std::min(shortSolve, timeSolve(kShort));
+      longSolve = std::min(longSolve, timeSolve(kLong));
+    }
     iterationSeconds = (longSolve - shortSolve) / (kLong - kShort);
     state.SetIterationTime(iterationSeconds);
   }
@@ -204,10 +222,11 @@ void PcgIteration(benchmark::State& state) {
   state.counters["default_iterations"] = defaultIterations;
 }
 
-// Arguments {size, threads, preconditioner (0 Gauss–Seidel, the default; 1 block Jacobi)}.
+// Arguments {size, threads, preconditioner (0 Gauss–Seidel, the default; 1 block Jacobi),
+// clock (0 wall; 1 the process's CPU time, summed over its threads, for a shared machine)}.
 BENCHMARK(PcgIteration)
-    ->ArgsProduct({{1, 4, 16}, {1, 2}, {0, 1}})
-    ->ArgNames({"size", "threads", "jacobi"})
+    ->ArgsProduct({{1, 4, 16}, {1, 2}, {0, 1}, {0, 1}})
+    ->ArgNames({"size", "threads", "jacobi", "cpu"})
     ->UseManualTime()
     ->Iterations(3)
     ->Unit(benchmark::kMicrosecond);
