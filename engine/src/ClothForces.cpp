@@ -3,6 +3,7 @@
 #include "forces/BaraffWitkin.h"
 #include "forces/IsometricBending.h"
 #include "forces/SpringCondition.h"
+#include "forces/StretchLaw.h"
 
 #include <weft/threading/GrainSizes.h>
 
@@ -374,6 +375,8 @@ Real ClothForces::evaluate(const Pass& pass) const {
   };
 
   const std::vector<TriangleRest>& triangles = m_model->triangles();
+  // Linear or biphasic stretch (forces/StretchLaw.h).
+  const StretchLaw warpLaw = warpStretchLaw(material), weftLaw = weftStretchLaw(material);
   forEachColour(m_triangleColours, [&](Index begin, Index end) {
     Real blockEnergy = 0;
     ElementForces<3> triangleForces;
@@ -387,12 +390,10 @@ Real ClothForces::evaluate(const Pass& pass) const {
       triangleForces.setZero();
       const StretchConditions stretch = stretchConditions(
           x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
-      accumulateConditionForces(stretch.warp, material.warpStretchStiffness,
-                                material.stretchDamping, velocities, mode, jacobians,
-                                triangleForces);
-      accumulateConditionForces(stretch.weft, material.weftStretchStiffness,
-                                material.stretchDamping, velocities, mode, jacobians,
-                                triangleForces);
+      accumulateStretchForces(stretch.warp, warpLaw, rest.area, material.stretchDamping,
+                              velocities, mode, jacobians, triangleForces);
+      accumulateStretchForces(stretch.weft, weftLaw, rest.area, material.stretchDamping,
+                              velocities, mode, jacobians, triangleForces);
       accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
                                 material.shearStiffness, material.shearDamping, velocities, mode,
                                 jacobians, triangleForces);

@@ -20,11 +20,25 @@
 // Thickness is the collision margin (ClothMaterial::thickness), not the caliper thickness of the
 // fabric (KES T ≈ 0.3–1.1 mm); it grows with the fabric's weight [EST]. Friction is the
 // cloth-on-cloth Coulomb coefficient, 0.2 (silk) to 0.35 (wool, linen, denim) [EST].
-// Strain limit (ClothMaterial::strainLimit): where the fabric leaves the low-strain regime its
-// stretch stiffness was fitted in and its straightened yarns make it nearly inextensible. Woven
-// fabrics reach that at a few to ~10 % (Provot 1995 uses 10 %); crimped wool a little later,
-// tightly woven heavy twill and flax earlier. All [EST]: neither source measures it.
+//  [KES-T] Kawabata's tensile test (KES-FB1): a strip stretched to 500 gf/cm (490 N/m); EMT is
+//        its strain at that load, LT = WT / (½ · 490 N/m · EMT) the linearity of the curve (1: a
+//        straight line; woven fabric 0.55–0.75: soft while the crimp straightens, stiff after).
+//        Typical apparel ranges as reported in the textile literature (Kawabata, The
+//        Standardization and Analysis of Hand Evaluation, 1980; Hu & Chan, Textile Res. J. 68,
+//        1998): shirting and lawn EMT 3–6 %, worsted suiting 4–8 %, polyester wovens 2–5 %, silk
+//        habutai and crêpe 4–10 %, denim 2–5 % (warp stiffer), linen 2–4 %.
+//
+// Stretch beyond the low-strain regime (ClothMaterial::stretchKneeStrain and the stiffened
+// stiffnesses): the biphasic law of forces/StretchLaw.h keeps each preset's low-strain slope up to
+// a knee and reproduces its KES tensile test beyond: the tension reaches 490 N/m at EMT, and the
+// curve's linearity is LT (biphasicFromKes below solves for the knee and the stiffened slopes).
+// Strain limit (ClothMaterial::strainLimit): EMT rounded up, where the measured range of the
+// tensile test ends. The material carries 490 N/m there, a load no cloth scene applies, so the
+// limiter is a safety net for numerical overshoot, not what holds the cloth: the biphasic law
+// keeps strain far below it.
 #include <weft/engine/FabricPresets.h>
+
+#include "forces/StretchLaw.h"
 
 #include <array>
 #include <cctype>
@@ -41,6 +55,37 @@ constexpr Real kBendingDampingTime = 5e-9 / 2.3e-6;  // s
 // gf·cm²/cm → N·m and gf/(cm·deg) → N/m per radian (see the note at the top).
 constexpr Real kBendingFromKes = 9.80665e-5;
 constexpr Real kShearFromKes = 0.980665 * 180.0 / 3.14159265358979323846;
+
+// KES-FB1's test load: 500 gf/cm in N/m.
+constexpr Real kKesTestTension = 500 * 9.80665e-3 / 0.01;
+
+// The knee of StretchLaw (forces/StretchLaw.h) whose curve from 0 to the extensibility `emt` has
+// the linearity `linearity` (LT) with the warp's low-strain stiffness k₀, the tension reaching
+// the test load at emt: LT(ε_k) falls from 1 (ε_k → 0) as the knee moves up, so bisection finds it.
+Real kneeFromKes(Real lowStiffness, Real emt, Real linearity) {
+  const auto lawLinearity = [&](Real knee) {
+    const StretchLaw law{lowStiffness, knee,
+                         (kKesTestTension - lowStiffness * emt) / (emt - 1.5 * knee)};
+    return stretchResponse(law, emt).energyDensity / (0.5 * kKesTestTension * emt);
+  };
+  Real low = 1e-6 * emt, high = 0.5 * emt;
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    const Real middle = 0.5 * (low + high);
+    (lawLinearity(middle) > linearity ? low : high) = middle;
+  }
+  return 0.5 * (low + high);
+}
+
+// Sets the biphasic stretch of `material` from KES tensile figures: the knee from the warp's EMT
+// and LT, and each direction's stiffened slope so that its tension is 490 N/m at its EMT.
+void setTensileTest(ClothMaterial& material, Real warpEmt, Real weftEmt, Real linearity) {
+  const Real knee = kneeFromKes(material.warpStretchStiffness, warpEmt, linearity);
+  material.stretchKneeStrain = knee;
+  material.warpStiffenedStretchStiffness =
+      (kKesTestTension - material.warpStretchStiffness * warpEmt) / (warpEmt - 1.5 * knee);
+  material.weftStiffenedStretchStiffness =
+      (kKesTestTension - material.weftStretchStiffness * weftEmt) / (weftEmt - 1.5 * knee);
+}
 
 // A material from its measured (or estimated) stiffnesses, damped like the curtain.
 ClothMaterial makeFabric(Real arealDensity, Real warpStretch, Real weftStretch, Real shear,
@@ -82,67 +127,79 @@ ClothMaterial cottonFabric() {
   // In KES terms: 0.15 kg/m² is a 150 g/m² shirting; D = 2.3e-6 N·m is B ≈ 0.023 gf·cm²/cm (a
   // light lawn; shirting is 0.05–0.1) [KES]; 100 N/m shear is G ≈ 1.8 gf/(cm·deg) [KES];
   // 260 N/m stretch lies within [W11]'s low-strain slopes (2·C: 33 N/m for the cotton/polyester
-  // interlock up to 2028 N/m for the denim weft). Strain limit 0.10: plain-woven cotton's
-  // low-strain regime ends at about 10 % [EST, Provot 1995's threshold]; the defaults leave the
-  // limiter off, the preset turns it on.
+  // interlock up to 2028 N/m for the denim weft). Tensile test: EMT 5 %, LT 0.65 [KES-T,
+  // shirting]: knee at 1.2 % (the curtain's self-weight strain, 0.8 %, stays below it),
+  // 14.8 kN/m from 2.4 % on. Strain limit 0.05, EMT. The defaults (ClothMaterial{}) are linear and
+  // unlimited; the preset adds the tensile test and the limiter.
   ClothMaterial material;
-  material.strainLimit = 0.10;
+  setTensileTest(material, 0.05, 0.05, 0.65);
+  material.strainLimit = 0.05;
   return material;
 }
 
 ClothMaterial woolFabric() {
-  return makeFabric(0.25,    // kg/m²: 250 g/m² worsted suiting [EST, catalogue weight]
+  ClothMaterial wool = makeFabric(0.25,    // kg/m²: 250 g/m² worsted suiting [EST, catalogue weight]
                     180.0,   // N/m warp [EST]: wool crimp makes it softer in stretch than cotton
                     150.0,   // N/m weft [EST]
                     0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, suiting]
                     0.10 * kBendingFromKes,   // B ≈ 0.10 gf·cm²/cm → 9.8e-6 N·m [KES, suiting]
                     0.35,    // [EST]
                     0.004,   // m [EST]
-                    0.15);   // strain [EST]: crimped wool yarns straighten before they extend
+                    0.07);   // strain: EMT [KES-T]
+  setTensileTest(wool, 0.06, 0.07, 0.65);  // EMT 6 % warp, 7 % weft, LT 0.65 [KES-T, suiting]
+  return wool;
 }
 
 ClothMaterial polyesterFabric() {
-  return makeFabric(0.113,   // kg/m² [W11 "tango-red-jet-set", 100 % polyester jacket]
+  ClothMaterial polyester = makeFabric(0.113,   // kg/m² [W11 "tango-red-jet-set", 100 % polyester jacket]
                     86.0,    // N/m warp = 2 × 43.1 [W11, first stretch sample]
                     343.0,   // N/m weft = 2 × 171.4 [W11, first stretch sample]
                     0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, polyester]
                     0.05 * kBendingFromKes,   // B ≈ 0.05 gf·cm²/cm → 4.9e-6 N·m [KES, polyester]
                     0.25,    // [EST]
                     0.003,   // m [EST]
-                    0.10);   // strain [EST]: a plain weave, like cotton
+                    0.04);   // strain: EMT [KES-T]
+  setTensileTest(polyester, 0.04, 0.04, 0.65);  // EMT 4 %, LT 0.65 [KES-T, polyester wovens]
+  return polyester;
 }
 
 ClothMaterial silkFabric() {
-  return makeFabric(0.06,    // kg/m²: 60 g/m² habutai / crêpe de Chine [EST, catalogue weight]
+  ClothMaterial silk = makeFabric(0.06,    // kg/m²: 60 g/m² habutai / crêpe de Chine [EST, catalogue weight]
                     200.0,   // N/m warp [EST]
                     200.0,   // N/m weft [EST]
                     0.4 * kShearFromKes,      // G ≈ 0.4 gf/(cm·deg) → 22 N/m [KES, silk]
                     0.015 * kBendingFromKes,  // B ≈ 0.015 gf·cm²/cm → 1.5e-6 N·m [KES, silk]
                     0.2,     // [EST]
                     0.002,   // m [EST]
-                    0.10);   // strain [EST]: a plain weave, like cotton
+                    0.07);   // strain: EMT [KES-T]
+  setTensileTest(silk, 0.07, 0.07, 0.65);  // EMT 7 %, LT 0.65 [KES-T, habutai and crêpe]
+  return silk;
 }
 
 ClothMaterial denimFabric() {
-  return makeFabric(0.324,   // kg/m² [W11 "11oz-black-denim", 99 % cotton]
+  ClothMaterial denim = makeFabric(0.324,   // kg/m² [W11 "11oz-black-denim", 99 % cotton]
                     411.0,   // N/m warp = 2 × 205.4 [W11, first stretch sample]
                     2028.0,  // N/m weft = 2 × 1013.9 [W11, first stretch sample]
                     2.0 * kShearFromKes,      // G ≈ 2.0 gf/(cm·deg) → 112 N/m [KES, denim 1.5–3.4]
                     0.17 * kBendingFromKes,   // B ≈ 0.17 gf·cm²/cm → 1.7e-5 N·m [KES, 0.14–0.23]
                     0.35,    // [EST]
                     0.004,   // m [EST]
-                    0.06);   // strain [EST]: a dense twill of heavy yarns, little crimp to give
+                    0.05);   // strain: EMT of the weft [KES-T]
+  setTensileTest(denim, 0.03, 0.05, 0.65);  // EMT 3 % warp, 5 % weft, LT 0.65 [KES-T, denim]
+  return denim;
 }
 
 ClothMaterial linenFabric() {
-  return makeFabric(0.18,    // kg/m²: 180 g/m² dress linen [EST, catalogue weight]
+  ClothMaterial linen = makeFabric(0.18,    // kg/m²: 180 g/m² dress linen [EST, catalogue weight]
                     400.0,   // N/m warp [EST]: flax yarns extend little
                     400.0,   // N/m weft [EST]
                     1.6 * kShearFromKes,      // G ≈ 1.6 gf/(cm·deg) → 90 N/m [KES, linen]
                     0.20 * kBendingFromKes,   // B ≈ 0.20 gf·cm²/cm → 2.0e-5 N·m [KES, linen]
                     0.35,    // [EST]
                     0.003,   // m [EST]
-                    0.06);   // strain [EST]: flax fibres extend only a few per cent
+                    0.03);   // strain: EMT [KES-T]
+  setTensileTest(linen, 0.03, 0.03, 0.65);  // EMT 3 %, LT 0.65 [KES-T, linen]
+  return linen;
 }
 
 std::span<const std::string_view> fabricPresetNames() { return kNames; }

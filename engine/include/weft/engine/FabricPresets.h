@@ -9,10 +9,15 @@
 //   - bending and shear: Kawabata KES-F ranges (B in gf·cm²/cm, G in gf/(cm·deg)) converted to
 //     SI, 1 gf·cm²/cm = 9.80665e-5 N·m and 1 gf/(cm·deg) = 56.19 N/m per radian of shear;
 //   - stretch: the low-strain slope of the Wang et al. 2011 fits, which, like the curtain's
-//     260 N/m, is the small-load regime, far softer than the KES secant at 500 gf/cm;
+//     260 N/m, is the small-load regime, up to a knee; past it the fabric stiffens so that it
+//     meets the KES tensile test (strain EMT at 500 gf/cm, linearity LT): a biphasic law in
+//     N/m (ClothMaterial::stretchKneeStrain), kilonewtons per metre once the yarns are straight;
+//   - strain limit: EMT, where the tensile test's measured range ends (a safety net: the
+//     material keeps strain far below it);
 //   - damping, friction and contact thickness: engineering estimates (no measurement behind them).
-// "cotton" is ClothMaterial{} (the curtain's material) with a strain limit of 0.10, and a test
-// keeps it so. The others are scaled estimates; treat them as starting points, not measurements.
+// "cotton" is ClothMaterial{} (the curtain's material) with its tensile test and a strain limit
+// of 0.05, and a test keeps it so. The others are scaled estimates; treat them as starting
+// points, not measurements.
 #pragma once
 
 #include <weft/Result.h>
@@ -23,7 +28,8 @@
 
 namespace weft {
 
-/// Light cotton (lawn/shirting): ClothMaterial{}, the curtain's material, with strainLimit 0.10.
+/// Light cotton (lawn/shirting): ClothMaterial{}, the curtain's material, stiffening past a 1.2 %
+/// knee (EMT 5 %, LT 0.65) and limited at 0.05.
 ClothMaterial cottonFabric();
 /// Wool suiting: heavier, softer in shear, stiffer in bending than cotton.
 ClothMaterial woolFabric();
