@@ -89,13 +89,13 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   settings.selfCollision = options.selfCollision;
   settings.skipUnneededStages = options.skips;
   settings.sleep = options.sleep;
-  Result<ClothMaterial> fabric = fabricPreset(options.fabric);
+  Result<ClothMaterial> fabric =
+      options.stiffening ? stiffeningFabricPreset(options.fabric) : fabricPreset(options.fabric);
   if (!fabric.ok()) {
     out << "weft-curtain: --fabric: " << fabric.error().message << "\n";
     return 2;
   }
   settings.material = fabric.value();
-  if (options.linearStretch) settings.material.stretchKneeStrain = 0;
   if (options.strainLimit >= 0) settings.material.strainLimit = options.strainLimit;
   Result<CurtainScene> created = CurtainScene::create(settings);
   if (!created.ok()) {

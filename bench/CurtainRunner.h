@@ -33,7 +33,7 @@ struct CurtainRunOptions {
   std::string trace;               ///< Chrome trace-event JSON path (Perfetto); empty = no profiling
   IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< time integrator
   std::string fabric = "cotton";   ///< the curtain's fabric preset (fabricPresetNames())
-  bool linearStretch = false;      ///< drop the preset's stretch knee: linear stretch, as before it
+  bool stiffening = false;         ///< the preset with its KES tensile test (stiffeningFabricPreset)
   double strainLimit = -1;         ///< overrides the preset's strain limit when ≥ 0 (0 = off)
   bool progress = true;            ///< print a progress line every second of simulated time
   bool overlap = true;             ///< render frame k while simulating frame k+1 (off: in turn)

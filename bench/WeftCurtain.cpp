@@ -52,8 +52,8 @@ int main(int argc, char** argv) {
   app.add_option("--fabric", options.fabric,
                  "Fabric preset of the curtain: cotton, wool, polyester, silk, denim or linen")
       ->check(CLI::IsMember({"cotton", "wool", "polyester", "silk", "denim", "linen"}));
-  app.add_flag("--linear-stretch", options.linearStretch,
-               "Linear stretch: drop the preset's stiffening past its knee");
+  app.add_flag("--stiffening", options.stiffening,
+               "The preset with its KES tensile test: stretch stiffening past a knee, limit at EMT");
   app.add_option("--strain-limit", options.strainLimit,
                  "Strain limit instead of the preset's (0 = off)")
       ->check(CLI::Range(0.0, 10.0));

@@ -32,14 +32,18 @@
 // stiffnesses): the biphasic law of forces/StretchLaw.h keeps each preset's low-strain slope up to
 // a knee and reproduces its KES tensile test beyond: the tension reaches 490 N/m at EMT, and the
 // curve's linearity is LT (biphasicFromKes below solves for the knee and the stiffened slopes).
-// Strain limit (ClothMaterial::strainLimit): EMT rounded up, where the measured range of the
-// tensile test ends. The material carries 490 N/m there, a load no cloth scene applies, so the
-// limiter is a safety net for numerical overshoot, not what holds the cloth: the biphasic law
-// keeps strain far below it.
+// Strain limit of the stiffening presets: EMT, where the measured range of the tensile test
+// ends. The material carries 490 N/m there, a load no cloth scene applies, so the limiter is a
+// safety net for numerical overshoot, not what holds the cloth.
+// Strain limit of the linear presets (ClothMaterial::strainLimit): where the fabric leaves the
+// low-strain regime its stretch stiffness was fitted in. Woven fabrics reach that at a few to
+// ~10 % (Provot 1995 uses 10 %); crimped wool a little later, tightly woven heavy twill and flax
+// earlier. All [EST]: neither source measures it.
 #include <weft/engine/FabricPresets.h>
 
 #include "forces/StretchLaw.h"
 
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <string>
@@ -127,79 +131,67 @@ ClothMaterial cottonFabric() {
   // In KES terms: 0.15 kg/m² is a 150 g/m² shirting; D = 2.3e-6 N·m is B ≈ 0.023 gf·cm²/cm (a
   // light lawn; shirting is 0.05–0.1) [KES]; 100 N/m shear is G ≈ 1.8 gf/(cm·deg) [KES];
   // 260 N/m stretch lies within [W11]'s low-strain slopes (2·C: 33 N/m for the cotton/polyester
-  // interlock up to 2028 N/m for the denim weft). Tensile test: EMT 5 %, LT 0.65 [KES-T,
-  // shirting]: knee at 1.2 % (the curtain's self-weight strain, 0.8 %, stays below it),
-  // 14.8 kN/m from 2.4 % on. Strain limit 0.05, EMT. The defaults (ClothMaterial{}) are linear and
-  // unlimited; the preset adds the tensile test and the limiter.
+  // interlock up to 2028 N/m for the denim weft). Strain limit 0.10: plain-woven cotton's
+  // low-strain regime ends at about 10 % [EST, Provot 1995's threshold]; the defaults leave the
+  // limiter off, the preset turns it on.
   ClothMaterial material;
-  setTensileTest(material, 0.05, 0.05, 0.65);
-  material.strainLimit = 0.05;
+  material.strainLimit = 0.10;
   return material;
 }
 
 ClothMaterial woolFabric() {
-  ClothMaterial wool = makeFabric(0.25,    // kg/m²: 250 g/m² worsted suiting [EST, catalogue weight]
+  return makeFabric(0.25,    // kg/m²: 250 g/m² worsted suiting [EST, catalogue weight]
                     180.0,   // N/m warp [EST]: wool crimp makes it softer in stretch than cotton
                     150.0,   // N/m weft [EST]
                     0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, suiting]
                     0.10 * kBendingFromKes,   // B ≈ 0.10 gf·cm²/cm → 9.8e-6 N·m [KES, suiting]
                     0.35,    // [EST]
                     0.004,   // m [EST]
-                    0.07);   // strain: EMT [KES-T]
-  setTensileTest(wool, 0.06, 0.07, 0.65);  // EMT 6 % warp, 7 % weft, LT 0.65 [KES-T, suiting]
-  return wool;
+                    0.15);   // strain [EST]: crimped wool yarns straighten before they extend
 }
 
 ClothMaterial polyesterFabric() {
-  ClothMaterial polyester = makeFabric(0.113,   // kg/m² [W11 "tango-red-jet-set", 100 % polyester jacket]
+  return makeFabric(0.113,   // kg/m² [W11 "tango-red-jet-set", 100 % polyester jacket]
                     86.0,    // N/m warp = 2 × 43.1 [W11, first stretch sample]
                     343.0,   // N/m weft = 2 × 171.4 [W11, first stretch sample]
                     0.6 * kShearFromKes,      // G ≈ 0.6 gf/(cm·deg) → 34 N/m [KES, polyester]
                     0.05 * kBendingFromKes,   // B ≈ 0.05 gf·cm²/cm → 4.9e-6 N·m [KES, polyester]
                     0.25,    // [EST]
                     0.003,   // m [EST]
-                    0.04);   // strain: EMT [KES-T]
-  setTensileTest(polyester, 0.04, 0.04, 0.65);  // EMT 4 %, LT 0.65 [KES-T, polyester wovens]
-  return polyester;
+                    0.10);   // strain [EST]: a plain weave, like cotton
 }
 
 ClothMaterial silkFabric() {
-  ClothMaterial silk = makeFabric(0.06,    // kg/m²: 60 g/m² habutai / crêpe de Chine [EST, catalogue weight]
+  return makeFabric(0.06,    // kg/m²: 60 g/m² habutai / crêpe de Chine [EST, catalogue weight]
                     200.0,   // N/m warp [EST]
                     200.0,   // N/m weft [EST]
                     0.4 * kShearFromKes,      // G ≈ 0.4 gf/(cm·deg) → 22 N/m [KES, silk]
                     0.015 * kBendingFromKes,  // B ≈ 0.015 gf·cm²/cm → 1.5e-6 N·m [KES, silk]
                     0.2,     // [EST]
                     0.002,   // m [EST]
-                    0.07);   // strain: EMT [KES-T]
-  setTensileTest(silk, 0.07, 0.07, 0.65);  // EMT 7 %, LT 0.65 [KES-T, habutai and crêpe]
-  return silk;
+                    0.10);   // strain [EST]: a plain weave, like cotton
 }
 
 ClothMaterial denimFabric() {
-  ClothMaterial denim = makeFabric(0.324,   // kg/m² [W11 "11oz-black-denim", 99 % cotton]
+  return makeFabric(0.324,   // kg/m² [W11 "11oz-black-denim", 99 % cotton]
                     411.0,   // N/m warp = 2 × 205.4 [W11, first stretch sample]
                     2028.0,  // N/m weft = 2 × 1013.9 [W11, first stretch sample]
                     2.0 * kShearFromKes,      // G ≈ 2.0 gf/(cm·deg) → 112 N/m [KES, denim 1.5–3.4]
                     0.17 * kBendingFromKes,   // B ≈ 0.17 gf·cm²/cm → 1.7e-5 N·m [KES, 0.14–0.23]
                     0.35,    // [EST]
                     0.004,   // m [EST]
-                    0.05);   // strain: EMT of the weft [KES-T]
-  setTensileTest(denim, 0.03, 0.05, 0.65);  // EMT 3 % warp, 5 % weft, LT 0.65 [KES-T, denim]
-  return denim;
+                    0.06);   // strain [EST]: a dense twill of heavy yarns, little crimp to give
 }
 
 ClothMaterial linenFabric() {
-  ClothMaterial linen = makeFabric(0.18,    // kg/m²: 180 g/m² dress linen [EST, catalogue weight]
+  return makeFabric(0.18,    // kg/m²: 180 g/m² dress linen [EST, catalogue weight]
                     400.0,   // N/m warp [EST]: flax yarns extend little
                     400.0,   // N/m weft [EST]
                     1.6 * kShearFromKes,      // G ≈ 1.6 gf/(cm·deg) → 90 N/m [KES, linen]
                     0.20 * kBendingFromKes,   // B ≈ 0.20 gf·cm²/cm → 2.0e-5 N·m [KES, linen]
                     0.35,    // [EST]
                     0.003,   // m [EST]
-                    0.03);   // strain: EMT [KES-T]
-  setTensileTest(linen, 0.03, 0.03, 0.65);  // EMT 3 %, LT 0.65 [KES-T, linen]
-  return linen;
+                    0.06);   // strain [EST]: flax fibres extend only a few per cent
 }
 
 std::span<const std::string_view> fabricPresetNames() { return kNames; }
@@ -217,6 +209,32 @@ Result<ClothMaterial> fabricPreset(std::string_view name) {
     valid += known;
   }
   return Error{"fabric preset '" + std::string(name) + "' is unknown; choose one of: " + valid};
+}
+
+Result<ClothMaterial> stiffeningFabricPreset(std::string_view name) {
+  // Tensile figures [KES-T]: EMT of warp and weft and the linearity LT. LT 0.65 for all, the
+  // middle of woven apparel fabrics' 0.55–0.75.
+  struct TensileTest {
+    std::string_view name;
+    Real warpEmt, weftEmt, linearity;
+  };
+  constexpr std::array<TensileTest, kNames.size()> kTests{{
+      {"cotton", 0.05, 0.05, 0.65},     // shirting, EMT 3–6 %
+      {"wool", 0.06, 0.07, 0.65},       // worsted suiting, 4–8 %
+      {"polyester", 0.04, 0.04, 0.65},  // polyester wovens, 2–5 %
+      {"silk", 0.07, 0.07, 0.65},       // habutai and crêpe, 4–10 %
+      {"denim", 0.03, 0.05, 0.65},      // denim, 2–5 %, the warp stiffer
+      {"linen", 0.03, 0.03, 0.65},      // linen, 2–4 %
+  }};
+  Result<ClothMaterial> preset = fabricPreset(name);
+  if (!preset.ok()) return preset;
+  ClothMaterial material = preset.value();
+  for (const TensileTest& test : kTests) {
+    if (!equalsIgnoringCase(name, test.name)) continue;
+    setTensileTest(material, test.warpEmt, test.weftEmt, test.linearity);
+    material.strainLimit = std::max(test.warpEmt, test.weftEmt);
+  }
+  return material;
 }
 
 }  // namespace weft

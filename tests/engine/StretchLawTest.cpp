@@ -160,7 +160,31 @@ TEST(StretchLaw, ValidationNamesTheFieldAndTheFix) {
   EXPECT_EQ(stretchLawProblem(material), "");
   for (std::string_view name : fabricPresetNames()) {
     EXPECT_EQ(stretchLawProblem(fabricPreset(name).value()), "") << name;
+    EXPECT_EQ(stretchLawProblem(stiffeningFabricPreset(name).value()), "") << name;
   }
+}
+
+TEST(StretchLaw, StiffeningPresetsMeetTheirKesTensileTest) {
+  // Kawabata's tensile test of cotton shirting (FabricPresets.cpp, [KES-T]): 500 gf/cm = 490.3 N/m
+  // at EMT = 5 %, linearity LT = WT / (½ · 490.3 N/m · EMT) = 0.65; the low-strain slope kept
+  // below the knee; the strain limit at EMT.
+  const ClothMaterial linear = cottonFabric();
+  const ClothMaterial cotton = stiffeningFabricPreset("cotton").value();
+  const Real load = 500 * 9.80665e-3 / 0.01, emt = 0.05;
+  const StretchLaw warp = warpStretchLaw(cotton);
+  ASSERT_TRUE(warp.stiffens());
+  EXPECT_EQ(warp.stiffness, linear.warpStretchStiffness);
+  EXPECT_NEAR(stretchResponse(warp, emt).tension, load, 1e-9 * load);
+  EXPECT_NEAR(stretchResponse(warp, emt).energyDensity / (0.5 * load * emt), 0.65, 1e-9);
+  EXPECT_NEAR(stretchResponse(weftStretchLaw(cotton), emt).tension, load, 1e-9 * load);
+  EXPECT_EQ(cotton.strainLimit, emt);
+  // The rest is the linear preset's.
+  EXPECT_EQ(cotton.arealDensity, linear.arealDensity);
+  EXPECT_EQ(cotton.stretchDamping, linear.stretchDamping);
+  EXPECT_EQ(cotton.shearStiffness, linear.shearStiffness);
+  EXPECT_EQ(cotton.bendingStiffness, linear.bendingStiffness);
+  EXPECT_EQ(linear.stretchKneeStrain, 0.0);
+  EXPECT_FALSE(stiffeningFabricPreset("velvet").ok());
 }
 
 }  // namespace

@@ -42,12 +42,12 @@ struct ClothMaterial {
   Real thickness = 0.003;             ///< m, contact thickness (collision)
   Real friction = 0.3;                ///< Coulomb friction coefficient (collision)
   /// Strain l / l_rest − 1 that no mesh edge exceeds at the end of a step (strain limiting,
-  /// Provot 1995): a safety net past what the stretch law holds. 0 or infinity = off (default);
-  /// the fabric presets set it at the end of their measured tensile range (cotton 0.05).
+  /// Provot 1995; woven fabric is nearly inextensible past ~10 %). Lower feels stiffer and costs
+  /// limiter iterations. 0 or infinity = off (default); the fabric presets set it (cotton 0.10).
   Real strainLimit = 0.0;
   /// Fibre strain at which the yarns have straightened and the stretch stiffness starts to rise
   /// towards the stiffened values below (reached at twice this strain): woven fabric's biphasic
-  /// tension. 0 or infinity = linear stretch (default); the fabric presets set it (cotton 0.02).
+  /// tension. 0 or infinity = linear stretch (default); stiffeningFabricPreset() sets it.
   Real stretchKneeStrain = 0.0;
   /// N/m, warp stretch stiffness past the knee (stretchKneeStrain); at least warpStretchStiffness.
   Real warpStiffenedStretchStiffness = 0.0;
