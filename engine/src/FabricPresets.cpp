@@ -63,13 +63,18 @@ constexpr Real kShearFromKes = 0.980665 * 180.0 / 3.14159265358979323846;
 // KES-FB1's test load: 500 gf/cm in N/m.
 constexpr Real kKesTestTension = 500 * 9.80665e-3 / 0.01;
 
+// The slope k₁ past 2 ε_k that brings the tension to the test load at emt ≥ 2 ε_k: there
+// T = k₀ emt + (k₁ − k₀)(emt − 3 ε_k / 2) (forces/StretchLaw.h).
+Real stiffenedSlope(Real lowStiffness, Real knee, Real emt) {
+  return lowStiffness + (kKesTestTension - lowStiffness * emt) / (emt - 1.5 * knee);
+}
+
 // The knee of StretchLaw (forces/StretchLaw.h) whose curve from 0 to the extensibility `emt` has
 // the linearity `linearity` (LT) with the warp's low-strain stiffness k₀, the tension reaching
 // the test load at emt: LT(ε_k) falls from 1 (ε_k → 0) as the knee moves up, so bisection finds it.
 Real kneeFromKes(Real lowStiffness, Real emt, Real linearity) {
   const auto lawLinearity = [&](Real knee) {
-    const StretchLaw law{lowStiffness, knee,
-                         (kKesTestTension - lowStiffness * emt) / (emt - 1.5 * knee)};
+    const StretchLaw law{lowStiffness, knee, stiffenedSlope(lowStiffness, knee, emt)};
     return stretchResponse(law, emt).energyDensity / (0.5 * kKesTestTension * emt);
   };
   Real low = 1e-6 * emt, high = 0.5 * emt;
@@ -86,9 +91,9 @@ void setTensileTest(ClothMaterial& material, Real warpEmt, Real weftEmt, Real li
   const Real knee = kneeFromKes(material.warpStretchStiffness, warpEmt, linearity);
   material.stretchKneeStrain = knee;
   material.warpStiffenedStretchStiffness =
-      (kKesTestTension - material.warpStretchStiffness * warpEmt) / (warpEmt - 1.5 * knee);
+      stiffenedSlope(material.warpStretchStiffness, knee, warpEmt);
   material.weftStiffenedStretchStiffness =
-      (kKesTestTension - material.weftStretchStiffness * weftEmt) / (weftEmt - 1.5 * knee);
+      stiffenedSlope(material.weftStretchStiffness, knee, weftEmt);
 }
 
 // A material from its measured (or estimated) stiffnesses, damped like the curtain.

@@ -49,7 +49,7 @@ Result<ClothMaterial> fabricPreset(std::string_view name);
 
 /// The preset of that name with its KES tensile test: linear up to a knee, stiffening past it so
 /// that the tension is 490 N/m at the fabric's EMT with linearity LT, and strainLimit = EMT.
-/// Cotton: knee 1.2 %, 14.8 kN/m from 2.4 %, limit 0.05. Unknown names fail as fabricPreset().
+/// Cotton: knee 1.2 %, 15.4 kN/m from 2.4 %, limit 0.05. Unknown names fail as fabricPreset().
 Result<ClothMaterial> stiffeningFabricPreset(std::string_view name);
 
 }  // namespace weft
