@@ -19,10 +19,10 @@ TEST(DefaultDynamics, APendulumKeepsTheAmplitudeAndPeriodItsMethodGives) {
   // The closed form of the method on the linear swing θ'' = −ω² θ: its growth factor ρ per step
   // (PendulumScene::growthFactor), so a period of 2π h / arg ρ and |ρ| kept per step. Bounds: the
   // 5° swing's nonlinearity moves ω by θ₀²/16 = 0.05 %, the springs' stretch (m g / 2k ≈ 5 µm on
-  // 1 m) by less, and the single linearisation per step (Baraff & Witkin's, the default) departs
-  // from the exact implicit step at the next order in ωh = 0.052: (ωh)² = 0.3 % of the per-step
-  // loss. So the loss per period within a tenth of the predicted loss (plus 0.1 % for a method
-  // that predicts almost none) and the period within 0.5 %.
+  // 1 m) by less. The single linearisation per step (the default) must not change the method:
+  // the loss per period within a tenth of the predicted loss (plus 0.1 % for a method that
+  // predicts almost none; BDF2 needs a Newton iteration for that, bench/results/
+  // error-time-curtain.md) and the period within 0.5 %.
   const SolverSettings defaults;
   ASSERT_EQ(defaults.substeps, 0u);
   ASSERT_EQ(defaults.maxImplicitStep, 1.0 / 60.0);  // one substep per 1/60 s frame
