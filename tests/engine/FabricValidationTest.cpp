@@ -113,10 +113,9 @@ TEST(Cantilever, DenimBendsWithinItsPublishedBendingLength) {
 
 TEST(CusickDrape, TheDrapeCoefficientRisesWithTheBendingLength) {
   // Cusick (J. Textile Inst. 56, 1965): the drape coefficient grows with the bending length. The
-  // presets, ordered by (D / ρ g)^(1/3), must drape in the same order (a 1 cm mesh suffices to
-  // rank them: the mesh moves a coefficient by ~0.01, neighbours differ by ≥ 0.03). Known engine
-  // failure: wool drapes below silk though it bends longer (its shear stiffness, which Cusick
-  // names as the second factor, is higher); every coefficient must still lie in (0, 1).
+  // presets, ordered by (D / ρ g)^(1/3), must drape in the same order on a 1 cm mesh (the mesh
+  // moves a coefficient by ~0.01; silk and wool lie closer than that, so their order is the
+  // fragile one). Every coefficient lies in (0, 1).
   std::vector<std::pair<Real, std::string>> byLength;
   for (std::string_view name : fabricPresetNames()) {
     const ClothMaterial m = fabricPreset(name).value();
@@ -124,18 +123,17 @@ TEST(CusickDrape, TheDrapeCoefficientRisesWithTheBendingLength) {
   }
   std::sort(byLength.begin(), byLength.end());
   Real previous = 0;
-  bool ordered = true;
   std::string figures;
   for (const auto& [length, name] : byLength) {
     const Real coefficient = drape(name, 0.01, 3, 2.5).coefficient;
     EXPECT_GT(coefficient, 0) << name;
     EXPECT_LT(coefficient, 1) << name;
-    ordered = ordered && coefficient > previous;
+    EXPECT_GT(coefficient, previous) << name << " (bending length " << 100 * length << " cm)";
     figures += name + " " + std::to_string(100 * length).substr(0, 4) + " cm: " +
                std::to_string(coefficient).substr(0, 5) + "; ";
     previous = coefficient;
   }
-  test::knownEngineFailure(ordered, "drape coefficients ordered by bending length", figures);
+  RecordProperty("drape_coefficients", figures);
 }
 
 INSTANTIATE_TEST_SUITE_P(Presets, FabricPreset,
