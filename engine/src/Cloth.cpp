@@ -208,7 +208,7 @@ std::string validate(const ClothModel* model, const ClothSettings& settings) {
     if (!problem.empty()) return "cloth settings: " + problem;
   }
   if (int(solver.integrator) < int(IntegratorKind::ExplicitEuler) ||
-      int(solver.integrator) > int(IntegratorKind::ImplicitEuler)) {
+      int(solver.integrator) > int(IntegratorKind::Bdf2)) {
     return "cloth settings: solver.integrator = " + std::to_string(int(solver.integrator)) +
            " is not an IntegratorKind; use one of the enumerators";
   }

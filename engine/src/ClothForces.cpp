@@ -3,6 +3,7 @@
 #include "forces/BaraffWitkin.h"
 #include "forces/IsometricBending.h"
 #include "forces/SpringCondition.h"
+#include "forces/StretchLaw.h"
 
 #include <weft/threading/GrainSizes.h>
 
@@ -470,7 +471,10 @@ Real ClothForces::evaluate(const Pass& pass) const {
     }
   };
 
-  if (!jacobians || mode == StiffnessMode::Definite) {
+  // Linear or biphasic stretch (forces/StretchLaw.h).
+  const StretchLaw warpLaw = warpStretchLaw(material), weftLaw = weftStretchLaw(material);
+  const bool linear = !warpLaw.stiffens() && !weftLaw.stiffens();
+  if (linear && (!jacobians || mode == StiffnessMode::Definite)) {
     // Stretch and shear fused (stretchShear): forces need no mode, Definite Jacobians are its own.
     const StretchShearCoefficients coefficients{material.warpStretchStiffness,
                                                 material.weftStretchStiffness,
@@ -506,12 +510,10 @@ Real ClothForces::evaluate(const Pass& pass) const {
         triangleForces.setZero();
         const StretchConditions stretch = stretchConditions(
             x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
-        accumulateConditionForces(stretch.warp, material.warpStretchStiffness,
-                                  material.stretchDamping, velocities, mode, jacobians,
-                                  triangleForces);
-        accumulateConditionForces(stretch.weft, material.weftStretchStiffness,
-                                  material.stretchDamping, velocities, mode, jacobians,
-                                  triangleForces);
+        accumulateStretchForces(stretch.warp, warpLaw, rest.area, material.stretchDamping,
+                                velocities, mode, jacobians, triangleForces);
+        accumulateStretchForces(stretch.weft, weftLaw, rest.area, material.stretchDamping,
+                                velocities, mode, jacobians, triangleForces);
         accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
                                   material.shearStiffness, material.shearDamping, velocities,
                                   mode, jacobians, triangleForces);

@@ -91,10 +91,11 @@ namespace weft {
 namespace {
 
 TEST(StepAllocation, SteadyStepsAllocateNothing) {
-  for (IntegratorKind integrator : {IntegratorKind::ImplicitEuler, IntegratorKind::RungeKutta4}) {
+  for (IntegratorKind integrator :
+       {IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2, IntegratorKind::RungeKutta4}) {
     CurtainSettings settings;
     settings.solver.integrator = integrator;
-    settings.solver.newtonIterations = integrator == IntegratorKind::ImplicitEuler ? 1 : 0;
+    settings.solver.newtonIterations = isImplicit(integrator) ? 1 : 0;
     CurtainScene scene = CurtainScene::create(settings).value();
     scene.stepFrame();  // first step sizes the scratch buffers
     g_allocations = 0;
