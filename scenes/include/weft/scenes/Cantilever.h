@@ -32,13 +32,16 @@ class CantileverScene {
   /// rad, D1388's angle: 41.5°, where Peirce's bending length is half the overhang.
   static constexpr Real kTestAngle = 41.5 * 3.14159265358979323846 / 180;
 
+  /// Builds the scene; fails on invalid settings, with the reason.
   static Result<CantileverScene> create(const CantileverSettings& settings = {});
 
+  /// Advances one frame of 1/60 s.
   StepStatus stepFrame() { return m_world->step(kFrameDt); }
   /// rad, the angle below the horizontal of the chord from the edge to the tip (the tip row's mean).
   Real chordAngle() const;
   /// m/s, the fastest vertex of the strip.
   Real largestSpeed() const;
+  /// The world that holds the strip, for stats and state.
   World& world() { return *m_world; }
 
   /// w l³ / D of the exact heavy elastica whose tip chord hangs `chordAngle` rad below the

@@ -41,15 +41,20 @@ class CusickDrapeScene {
  public:
   static constexpr Real kFrameDt = 1.0 / 60.0;  ///< s, one frame
 
+  /// Builds the scene; fails on invalid settings, with the reason.
   static Result<CusickDrapeScene> create(const CusickDrapeSettings& settings = {});
 
+  /// Advances one frame of 1/60 s.
   StepStatus stepFrame() { return m_world->step(kFrameDt); }
   /// The drape coefficient of the shape now: its shadow from above rasterised at 0.5 mm.
   Real drapeCoefficient() const;
   /// m/s, the fastest hem (edge-ring) vertex: the drape has settled when the hem stops creeping.
   Real hemSpeed() const;
+  /// The world that holds the disc and the pedestal.
   World& world() { return *m_world; }
+  /// The disc's cloth in world().
   ClothId cloth() const { return m_cloth; }
+  /// The disc's mesh (irregular).
   const ClothModel& model() const { return *m_model; }
 
  private:

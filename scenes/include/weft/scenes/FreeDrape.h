@@ -37,8 +37,11 @@ class FreeDrapeScene {
 
   /// Advances one frame (substeps as the solver settings plan them).
   StepStatus stepFrame() { return m_world->step(kFrameDt); }
+  /// The world that holds the sheet.
   World& world() { return *m_world; }
+  /// The sheet's cloth in world().
   ClothId cloth() const { return m_cloth; }
+  /// The sheet's mesh.
   const ClothModel& model() const { return *m_model; }
   /// Positions now (m), one per vertex.
   std::span<const Vec3> positions() const { return m_world->positions(m_cloth).value(); }

@@ -32,6 +32,7 @@ class PendulumScene {
   static constexpr Real kFrameDt = 1.0 / 60.0;  ///< s, one frame
   static constexpr Real kGravity = 9.81;        ///< m/s²
 
+  /// Builds the scene; fails on invalid settings, with the reason.
   static Result<PendulumScene> create(const PendulumSettings& settings = {});
 
   /// Advances one frame of 1/60 s (substeps as the solver plans them).
@@ -46,6 +47,7 @@ class PendulumScene {
   /// root that tends to 1 as h → 0: ρ = (2 + √(1 + 2z))/(3 − 2z). Its modulus is the amplitude
   /// kept per step, its argument the phase advanced (the period is 2π h / arg ρ). NaN for explicit methods.
   static std::complex<Real> growthFactor(IntegratorKind kind, Real omegaH);
+  /// The world that holds the pendulum.
   World& world() { return *m_world; }
 
  private:
