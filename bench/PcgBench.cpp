@@ -25,6 +25,7 @@
 //   cache_bound_us bytes / same-size triad bandwidth; cache_ratio = iteration_us / cache_bound_us
 //   bytes, memory_GBps, cache_GBps, default_iterations (a default solve from Δv = 0)
 #include "ClothForces.h"
+#include "CurtainSnapshot.h"
 
 #include "solver/BlockSparseMatrix.h"
 #include "solver/FilteredPcg.h"
@@ -59,14 +60,12 @@ struct CurtainPcgSystem {
   std::vector<Index> rowColors;
 
   explicit CurtainPcgSystem(Index size) {
-    CurtainSettings settings;
-    settings.size = size;
-    scene = std::make_unique<CurtainScene>(CurtainScene::create(settings).value());
-    for (int frame = 0; frame < 12; ++frame) scene->stepFrame();
+    CurtainSnapshot snapshot = curtainSnapshot(size);
+    const CurtainSettings& settings = snapshot.settings;
+    scene = std::move(snapshot.scene);
+    const Vec3Array& x = snapshot.x;
+    const Vec3Array& v = snapshot.v;
     const ClothModel& model = scene->model();
-    const auto positions = scene->world().positions(scene->cloth()).value();
-    const auto velocities = scene->world().velocities(scene->cloth()).value();
-    const Vec3Array x(positions.begin(), positions.end()), v(velocities.begin(), velocities.end());
     ClothForceSettings forceSettings;
     forceSettings.material = settings.material;
     const std::vector<Real> masses = model.vertexMasses(settings.material.arealDensity);
