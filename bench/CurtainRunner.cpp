@@ -89,6 +89,14 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
   settings.selfCollision = options.selfCollision;
   settings.skipUnneededStages = options.skips;
   settings.sleep = options.sleep;
+  Result<ClothMaterial> fabric =
+      options.stiffening ? stiffeningFabricPreset(options.fabric) : fabricPreset(options.fabric);
+  if (!fabric.ok()) {
+    out << "weft-curtain: --fabric: " << fabric.error().message << "\n";
+    return 2;
+  }
+  settings.material = fabric.value();
+  if (options.strainLimit >= 0) settings.material.strainLimit = options.strainLimit;
   Result<CurtainScene> created = CurtainScene::create(settings);
   if (!created.ok()) {
     out << "weft-curtain: " << created.error().message << "\n";
@@ -105,7 +113,10 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
       << scene.world().plannedSubsteps(scene.cloth(), CurtainScene::kFrameDt).value()
       << " substep(s) per 1/60 s frame\n"
       << "  frames     " << options.frames << " (" << options.frames * CurtainScene::kFrameDt
-      << " s simulated)\n";
+      << " s simulated)\n"
+      << "  fabric     " << options.fabric << ", stretch "
+      << (settings.material.stretchKneeStrain > 0 ? "biphasic (knee " + std::to_string(settings.material.stretchKneeStrain) + ")" : std::string("linear"))
+      << ", strain limit " << settings.material.strainLimit << "\n";
   // Say plainly what this build does not do yet, rather than print numbers that look complete.
   out << "  threads    " << scene.world().threadCount() << " (machine has " << hardwareThreads
       << " cores)\n";
@@ -303,7 +314,18 @@ int runCurtain(const CurtainRunOptions& options, std::ostream& out) {
       << 1000.0 / frameP99 << "\n"
       << "  CG iterations  mean " << mean(iterations) << "  max " << percentile(iterations, 100)
       << "  (frames not converged: " << unconverged << ")\n"
-      << std::setprecision(5) << "  max strain     " << maxStrain << "\n"
+      << std::setprecision(5) << "  max strain     " << maxStrain << "\n";
+  // The largest strain of each phase of the script the run reached.
+  out << "  max strain by phase";
+  for (const CurtainPhase& phase : CurtainScene::phases()) {
+    const std::size_t first = std::size_t(std::lround(phase.begin / CurtainScene::kFrameDt));
+    const std::size_t last = std::min(records.size(), std::size_t(std::lround(phase.end / CurtainScene::kFrameDt)));
+    if (first >= last) break;
+    double largest = 0;
+    for (std::size_t k = first; k < last; ++k) largest = std::max(largest, records[k].maxStrain);
+    out << "  " << phase.name << " " << std::setprecision(4) << largest;
+  }
+  out << "\n"
       << "  unstable       " << unstable << " frame(s), non-finite: " << (nonfinite ? "yes" : "no")
       << "\n"
       << "  state hash     " << hex(hash) << "\n";

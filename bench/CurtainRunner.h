@@ -32,6 +32,9 @@ struct CurtainRunOptions {
   std::string frameCsv;            ///< per-frame CSV path, with a PNG chart beside it; empty = none
   std::string trace;               ///< Chrome trace-event JSON path (Perfetto); empty = no profiling
   IntegratorKind integrator = IntegratorKind::ImplicitEuler;  ///< time integrator
+  std::string fabric = "cotton";   ///< the curtain's fabric preset (fabricPresetNames())
+  bool stiffening = false;         ///< the preset with its KES tensile test (stiffeningFabricPreset)
+  double strainLimit = -1;         ///< overrides the preset's strain limit when ≥ 0 (0 = off)
   bool progress = true;            ///< print a progress line every second of simulated time
   bool overlap = true;             ///< render frame k while simulating frame k+1 (off: in turn)
 };

@@ -1,28 +1,40 @@
-// Error-vs-time sweep: accuracy against cost on the curtain (bench/results/error-time-curtain.md).
+// Error-vs-time sweep on the curtain (bench/results/error-time-curtain.md).
 //
-// Design note. Every run is the curtain scene with its pin script, stepped frame by frame exactly
-// as the curtain runner does, with one SolverSettings changed. Its error is measured against a
-// reference run of the same scene: backward Euler at 1/16 of the frame step (or smaller), PCG to
-// a 1e-10 residual, Newton-refined, in double precision. The reference is expensive, so it is
-// cached in a small binary file keyed by everything that defines it, including a fingerprint of
-// the engine (the state hash after two reference frames); a sweep with a different key
-// recomputes it. Errors are taken at a few fixed times (not every frame) so that comparing
-// costs nothing next to simulating, and divided by the cloth's characteristic length (its rest
-// bounding-box diagonal, 2.5 m) to be dimensionless:
-//   rms_error     max over sample times of the RMS vertex distance to the reference
-//   max_error     max over sample times and vertices of that distance
-//   strain_error  max over sample times of |max strain − reference max strain|
-//   energy_drift  max over sample times of |E − E_ref| / (M g L), E = kinetic + elastic + gravity
-// Wall time is measured around World::step only, in the same run, and given per simulated second;
-// with --repeat N the fastest of N identical runs is kept (the machine is shared: noise is real).
-// Runs whose step reported Unstable or RolledBack are kept in the CSV, flagged, and left out of
-// the Pareto front; such a run stops at the first flagged frame (its errors are then n/a).
+// Design note. Every run is the curtain scene with its script, stepped frame by frame on one
+// thread, with one SolverSettings changed (or Bullet's soft body on the same script). Its cost is
+// the CPU time of the stepping thread per simulated second: the machine is shared, and thread CPU
+// time is what a run costs whatever else the cores do (wall time would rank the neighbours'
+// builds). Its error is measured against a reference run every 0.1 s of the script and reported
+// per phase of the script (settle, the sphere's push, ..., the rod's gather), never at one
+// instant:
+//   rms        max over the phase's samples of the RMS vertex distance to the reference
+//   statistics the largest of four shape statistics' differences from the reference, averaged
+//              over the phase's samples: energy (kinetic + elastic + gravity, / M g L), the edge
+//              strain's 50/90/99/100th percentiles, the collider contacts (per vertex) and the
+//              front silhouette (1 − intersection / union of the covered cells)
+// both divided by the cloth's characteristic length (2.5 m) where they are lengths.
 //
-// What the reference is not: backward Euler is first order, so the reference itself is off from
-// the exact solution by O(h_ref). Errors far below the reference's own error (higher-order
-// methods at small steps) are therefore measured against the reference, not against the truth;
-// the sweep says so in its output. Threads are not swept: the engine steps serially for now.
+// The reference must be shown to converge. It is run twice, at its step and at half its step
+// (the "check"); per phase, the check's distance to the reference bounds the reference's own
+// error, and a phase's vertex errors are ranked only where they are at least 10× that bound: a
+// smaller error is reported as unresolved (below the floor) and ties with every other error
+// below the floor. Where the floor is above the configurations' errors the phase is ranked by
+// its statistics instead, under the same 10× rule. A phase is called chaotic when a 1 nm change
+// of the starting shape grows, in a run with converged solves, to at least a tenth of the errors
+// ranked: there vertex distances measure the chaos, not the method. The references are cached in a
+// binary file keyed by everything that defines them, including the engine's fingerprint (the
+// state hash after two reference frames).
+//
+// Bullet's points (bench/peers/BulletCurtain.h) run the same script with Bullet's own settings,
+// measured against the same reference samples; it has no velocities to read, so its energy is
+// left out of its statistics.
 #include "ErrorTime.h"
+
+#include "ClothStatistics.h"
+
+#if WEFT_HAVE_BULLET
+#include "peers/BulletCurtain.h"
+#endif
 
 #include <weft/scenes/Curtain.h>
 
@@ -30,13 +42,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <limits>
 #include <map>
+#include <optional>
 #include <sstream>
 #include <vector>
 
@@ -44,36 +58,69 @@ namespace weft {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+constexpr Real kNaN = std::numeric_limits<Real>::quiet_NaN();
+constexpr Index kSampleEveryFrames = 6;  // 0.1 s
+constexpr Real kResolution = 10;         // a ranked error is at least this × the reference's
+constexpr Real kTimingNoise = 0.1;       // CPU-time differences under 10 % are not a ranking
 
-// One cloth state at a sample time, with the quantities errors are computed from.
+double threadCpuSeconds() {
+  timespec now{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
+  return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
+}
+
+// One cloth state at a sample time, with what the statistics need beyond the positions.
 struct Sample {
-  Index frame = 0;   // frames stepped when it was taken
-  Vec3Array positions, velocities;
-  Real maxStrain = 0;
-  Real energy = 0;   // J, kinetic + elastic + gravity
+  Index frame = 0;
+  Vec3Array positions, velocities;  // velocities empty for Bullet
+  Real energy = kNaN;               // J, kinetic + elastic + gravity
+  Real contacts = kNaN;             // cloth vertices touching a collider
 };
 
-// One point of the sweep.
+// One point of the sweep: a Weft solver setting, or a Bullet setting.
 struct SweepConfig {
-  std::string method;        // "implicit-euler", "implicit-newton", "rk4", ...
+  std::string method;  // "implicit-euler", "bdf2-newton1", "bullet", ...
   SolverSettings solver;
-  bool isDefaults = false;   // SolverSettings{} untouched
+  bool isDefaults = false;
+  bool isBullet = false;
+  int bulletIterations = 1, bulletSubsteps = 1;
+};
+
+struct PhaseError {
+  Real rms = kNaN;         // max over the phase's samples, / L
+  Real energy = kNaN;      // mean |E − E_ref| / (M g L)
+  Real strain = kNaN;      // mean largest percentile difference (strain)
+  Real contacts = kNaN;    // |mean contacts − reference's| / vertices
+  Real silhouette = kNaN;  // mean 1 − IoU
+
+  Real statistics() const {
+    Real largest = kNaN;
+    for (Real value : {energy, strain, contacts, silhouette}) {
+      if (std::isfinite(value)) largest = std::isfinite(largest) ? std::max(largest, value) : value;
+    }
+    return largest;
+  }
 };
 
 struct RunResult {
   SweepConfig config;
-  Index substeps = 0;            // per frame, as the world planned them
+  Index substeps = 0;
   StepStatus status = StepStatus::Ok;
-  bool stable = true;            // neither Unstable nor RolledBack
+  bool stable = true;
   Index framesRun = 0;
-  Real wallPerSimulated = 0;     // s of wall time per simulated s
+  Real cpuPerSimulated = 0;  // CPU s of the stepping thread per simulated s
   Real cgIterationsPerFrame = 0;
-  Real rmsError = 0, maxError = 0, strainError = 0, energyDrift = 0;
+  std::vector<PhaseError> phases;
 };
 
-// Total mechanical energy of a curtain state: kinetic from the velocities, elastic and gravity from
-// a probe world that evaluates the same forces at exactly that state (World reports the potential
-// energy at the start of its last substep; one tiny step of the probe gives it at the state set).
+struct Phase {
+  std::string name;
+  Real begin = 0, end = 0;
+  std::vector<std::size_t> samples;  // indices into the sample list
+};
+
+// Total mechanical energy of a curtain state, from a probe world that evaluates the same forces
+// at exactly that state (one tiny step reports the potential energy of the state set).
 class EnergyProbe {
  public:
   EnergyProbe(std::shared_ptr<const ClothModel> model, const ClothMaterial& material)
@@ -81,13 +128,12 @@ class EnergyProbe {
     ClothSettings settings;
     settings.material = material;
     settings.solver.substeps = 1;
+    settings.sleep.enabled = false;
     m_cloth = m_world.createCloth(std::move(model), settings).value();
   }
 
   Real energy(const Vec3Array& positions, const Vec3Array& velocities) {
-    if (!m_world.setState(m_cloth, positions, velocities).ok()) {
-      return std::numeric_limits<Real>::quiet_NaN();
-    }
+    if (velocities.empty() || !m_world.setState(m_cloth, positions, velocities).ok()) return kNaN;
     m_world.step(1e-12);  // s: only to evaluate the potential energy at the state just set
     Real kinetic = 0;
     for (std::size_t i = 0; i < velocities.size(); ++i) {
@@ -97,19 +143,20 @@ class EnergyProbe {
   }
 
  private:
-  World m_world;
+  World m_world{WorldSettings{.threadCount = 1}};
   ClothId m_cloth;
   std::vector<Real> m_masses;
 };
 
-// Steps one curtain with the given solver to the last sample frame, recording samples and time.
+// Steps one Weft curtain to the last sample frame, recording samples and CPU time. A non-zero
+// `perturbation` (m) moves every free vertex by that much first, in a fixed pattern.
 RunResult runCurtain(const SweepConfig& config, const std::vector<Index>& sampleFrames,
-                     std::vector<Sample>* samples, EnergyProbe& probe, Index size) {
+                     std::vector<Sample>& samples, EnergyProbe& probe, Real perturbation = 0) {
   RunResult result;
   result.config = config;
   CurtainSettings settings;
-  settings.size = size;
   settings.solver = config.solver;
+  settings.threadCount = 1;
   Result<CurtainScene> created = CurtainScene::create(settings);
   if (!created.ok()) {
     result.stable = false;
@@ -118,20 +165,27 @@ RunResult runCurtain(const SweepConfig& config, const std::vector<Index>& sample
   }
   CurtainScene& scene = created.value();
   World& world = scene.world();
+  if (perturbation != 0) {
+    const std::span<const Vec3> x = world.positions(scene.cloth()).value();
+    Vec3Array moved(x.begin(), x.end());
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+      moved[i] += perturbation * Vec3(std::sin(1.7 * Real(i)), std::cos(2.3 * Real(i)), std::sin(0.9 * Real(i)));
+    }
+    (void)world.setState(scene.cloth(), moved, Vec3Array(moved.size(), Vec3::Zero()));
+  }
   result.substeps = world.plannedSubsteps(scene.cloth(), CurtainScene::kFrameDt).value();
-  const Index lastFrame = sampleFrames.back();
-  double wallSeconds = 0;
+  double cpuSeconds = 0;
   long long cgIterations = 0;
   std::size_t nextSample = 0;
-  for (Index frame = 1; frame <= lastFrame; ++frame) {
-    const Clock::time_point start = Clock::now();
+  samples.clear();
+  for (Index frame = 1; frame <= sampleFrames.back(); ++frame) {
+    const double start = threadCpuSeconds();
     const StepStatus status = scene.stepFrame();
-    wallSeconds += std::chrono::duration<double>(Clock::now() - start).count();
+    cpuSeconds += threadCpuSeconds() - start;
     result.status |= status;
     cgIterations += world.stats().cgIterations;
     result.framesRun = frame;
-    // Unstable or rolled back: the run is out of the front whatever follows, so stop here (the
-    // engine's retries make an unstable run slow, and a rolled-back state no longer moves).
+    // Unstable or rolled back: out of the front whatever follows (and retries make it slow).
     if (hasFlag(status, StepStatus::Unstable) || hasFlag(status, StepStatus::RolledBack)) break;
     if (frame == sampleFrames[nextSample]) {
       Sample sample;
@@ -140,26 +194,72 @@ RunResult runCurtain(const SweepConfig& config, const std::vector<Index>& sample
       const std::span<const Vec3> v = world.velocities(scene.cloth()).value();
       sample.positions.assign(x.begin(), x.end());
       sample.velocities.assign(v.begin(), v.end());
-      sample.maxStrain = world.stats().maxStrain;
       sample.energy = probe.energy(sample.positions, sample.velocities);
-      samples->push_back(std::move(sample));
+      sample.contacts = Real(world.stats().contacts);
+      samples.push_back(std::move(sample));
       ++nextSample;
     }
   }
   result.stable = !hasFlag(result.status, StepStatus::Unstable) &&
                   !hasFlag(result.status, StepStatus::RolledBack) &&
-                  samples->size() == sampleFrames.size();
+                  samples.size() == sampleFrames.size();
   const Real simulated = Real(result.framesRun) * CurtainScene::kFrameDt;
-  result.wallPerSimulated = simulated > 0 ? wallSeconds / simulated : 0;
+  result.cpuPerSimulated = simulated > 0 ? cpuSeconds / simulated : 0;
   result.cgIterationsPerFrame = result.framesRun ? Real(cgIterations) / Real(result.framesRun) : 0;
   return result;
 }
 
-// ---- reference cache ------------------------------------------------------------------------
-// Binary, native endianness: "WEFTREF1", u32 key length, key bytes, u32 samples, u32 vertices,
-// then per sample: u32 frame, f64 max strain, f64 energy, 3n f64 positions, 3n f64 velocities.
+#if WEFT_HAVE_BULLET
+RunResult runBullet(const SweepConfig& config, const std::vector<Index>& sampleFrames,
+                    std::vector<Sample>& samples) {
+  RunResult result;
+  result.config = config;
+  result.substeps = config.bulletSubsteps;
+  BulletCurtainSettings settings;
+  settings.positionIterations = config.bulletIterations;
+  settings.substeps = config.bulletSubsteps;
+  Result<std::unique_ptr<BulletCurtain>> created = BulletCurtain::create(settings);
+  if (!created.ok()) {
+    result.stable = false;
+    result.status = StepStatus::InvalidInput;
+    return result;
+  }
+  BulletCurtain& bullet = *created.value();
+  double cpuSeconds = 0;
+  std::size_t nextSample = 0;
+  samples.clear();
+  for (Index frame = 1; frame <= sampleFrames.back(); ++frame) {
+    const double start = threadCpuSeconds();
+    bullet.stepFrame();
+    cpuSeconds += threadCpuSeconds() - start;
+    result.framesRun = frame;
+    if (frame == sampleFrames[nextSample]) {
+      Sample sample;
+      sample.frame = frame;
+      bullet.readPositions(sample.positions);
+      bool finite = true;
+      for (const Vec3& x : sample.positions) finite = finite && x.allFinite();
+      if (!finite) {
+        result.stable = false;
+        result.status = StepStatus::Unstable;  // Bullet blew up
+        break;
+      }
+      samples.push_back(std::move(sample));
+      ++nextSample;
+    }
+  }
+  result.stable = result.stable && samples.size() == sampleFrames.size();
+  const Real simulated = Real(result.framesRun) * CurtainScene::kFrameDt;
+  result.cpuPerSimulated = simulated > 0 ? cpuSeconds / simulated : 0;
+  return result;
+}
+#endif
 
-constexpr char kCacheMagic[8] = {'W', 'E', 'F', 'T', 'R', 'E', 'F', '1'};
+// ---- reference cache ------------------------------------------------------------------------
+// Binary, native endianness: "WEFTREF2", u32 key length, key bytes, u32 samples, u32 vertices,
+// then per sample: u32 frame, f64 energy, f64 contacts, 3n f64 positions, 3n f64 velocities.
+
+constexpr char kCacheMagic[8] = {'W', 'E', 'F', 'T', 'R', 'E', 'F', '2'};
 
 template <typename T>
 void writeValue(std::ofstream& file, const T& value) {
@@ -180,8 +280,8 @@ bool saveReference(const std::string& path, const std::string& key, const std::v
   writeValue(file, std::uint32_t(samples.empty() ? 0 : samples[0].positions.size()));
   for (const Sample& sample : samples) {
     writeValue(file, std::uint32_t(sample.frame));
-    writeValue(file, sample.maxStrain);
     writeValue(file, sample.energy);
+    writeValue(file, sample.contacts);
     for (const Vec3Array* array : {&sample.positions, &sample.velocities}) {
       for (const Vec3& value : *array) file.write(reinterpret_cast<const char*>(value.data()), 3 * sizeof(Real));
     }
@@ -200,12 +300,12 @@ std::vector<Sample> loadReference(const std::string& path, const std::string& ke
   std::uint32_t keyLength = 0, sampleCount = 0, vertexCount = 0;
   if (!file.read(magic, sizeof(magic)) || !std::equal(magic, magic + sizeof(magic), kCacheMagic) ||
       !readValue(file, keyLength) || keyLength > (1u << 16)) {
-    why = "not a weft-error-time reference file";
+    why = "not a weft-error-time reference file of this version";
     return {};
   }
   std::string storedKey(keyLength, '\0');
   if (!file.read(storedKey.data(), keyLength) || storedKey != key) {
-    why = "made for other reference settings";
+    why = "made for other reference settings or another engine";
     return {};
   }
   if (!readValue(file, sampleCount) || !readValue(file, vertexCount)) {
@@ -215,7 +315,7 @@ std::vector<Sample> loadReference(const std::string& path, const std::string& ke
   std::vector<Sample> samples(sampleCount);
   for (Sample& sample : samples) {
     std::uint32_t frame = 0;
-    if (!readValue(file, frame) || !readValue(file, sample.maxStrain) || !readValue(file, sample.energy)) {
+    if (!readValue(file, frame) || !readValue(file, sample.energy) || !readValue(file, sample.contacts)) {
       why = "truncated";
       return {};
     }
@@ -233,7 +333,7 @@ std::vector<Sample> loadReference(const std::string& path, const std::string& ke
   return samples;
 }
 
-// ---- the sweep ------------------------------------------------------------------------------
+// ---- configurations -------------------------------------------------------------------------
 
 std::string formatTolerance(Real tolerance) {
   std::ostringstream text;
@@ -242,209 +342,337 @@ std::string formatTolerance(Real tolerance) {
 }
 
 std::string describeConfig(const RunResult& run) {
+  const SweepConfig& config = run.config;
   std::ostringstream text;
-  text << run.config.method << " h=1/" << std::lround(run.substeps / CurtainScene::kFrameDt);
-  if (run.config.solver.integrator == IntegratorKind::ImplicitEuler) {
-    text << " tol=" << formatTolerance(run.config.solver.cgTolerance);
-    // The defaults name their stopping test (the series say it in their method name) and the
-    // contact-aware tightening (SolverSettings::tightCgTolerance: the residual tolerance of hard
-    // substeps, after a self-collision pass with at least that many contacts per vertex).
-    if (run.config.isDefaults) {
-      text << (run.config.solver.cgStopping == PcgStopping::VelocityError ? " verr" : " residual");
-    }
-    if (run.config.solver.tightCgTolerance > 0) {
-      text << " tight=" << formatTolerance(run.config.solver.tightCgTolerance) << "@"
-           << run.config.solver.tightSelfContactDensity;
-    }
-    text << (run.config.solver.warmStart ? " warm" : " cold");
+  if (config.isBullet) {
+    text << "bullet piterations=" << config.bulletIterations << " steps/frame="
+         << config.bulletSubsteps;
+    return text.str();
   }
-  if (run.config.solver.substeps == 0) text << " (auto)";
-  if (run.config.isDefaults) text << " [defaults]";
+  text << config.method << " h=1/" << std::lround(Real(run.substeps) / CurtainScene::kFrameDt);
+  if (isImplicit(config.solver.integrator)) {
+    text << " tol=" << formatTolerance(config.solver.cgTolerance);
+    if (config.isDefaults) {
+      text << (config.solver.cgStopping == PcgStopping::VelocityError ? " verr" : " residual");
+      if (config.solver.tightCgTolerance > 0) {
+        text << " tight=" << formatTolerance(config.solver.tightCgTolerance);
+      }
+    }
+  }
+  if (config.solver.substeps == 0) text << " (auto)";
+  if (config.isDefaults) text << " [defaults]";
   return text.str();
 }
 
+// The grid: the defaults first; backward Euler and BDF2 over steps and tolerances with both
+// stopping tests, BDF2 with a Newton iteration, the explicit methods at the substeps their
+// stability needs, Bullet at a range of iterations.
 std::vector<SweepConfig> sweepConfigs(const ErrorTimeOptions& options) {
-  std::vector<Index> substeps, explicitSubsteps;
-  std::vector<Real> tolerances;
-  std::vector<bool> warmStarts{true, false};
+  std::vector<Index> substeps;
+  std::vector<Real> residualTolerances, velocityTolerances;
   if (options.full) {
-    substeps = {1, 2, 4, 8, 16, 32};
-    explicitSubsteps = substeps;
-    tolerances = {1e-2, 5e-3, 1e-3, 1e-4, 1e-6, 1e-8};
+    substeps = {1, 2, 4, 8, 16};
+    residualTolerances = {1e-1, 1e-2, 1e-3, 1e-6};
+    velocityTolerances = {1e-1, 3e-2, 1e-2};
   } else if (options.quick) {
     substeps = {1, 2, 4, 8};
-    explicitSubsteps = {8, 32};
-    tolerances = {1e-1, 5e-2, 3e-2, 2e-2, 1e-2, 5e-3, 1e-3, 1e-8};
+    residualTolerances = {1e-1, 1e-3};
+    velocityTolerances = {1e-1, 3e-2};
   } else {
-    substeps = {1, 2, 4, 8, 16};
-    explicitSubsteps = {4, 8, 16, 32};
-    tolerances = {1e-2, 1e-3, 1e-4, 1e-6, 1e-8};
+    substeps = {1, 2, 4, 8};
+    residualTolerances = {1e-1, 1e-2, 1e-4};
+    velocityTolerances = {1e-1, 3e-2, 1e-2};
   }
   std::vector<SweepConfig> configs;
-  // The engine's defaults, untouched, first.
   configs.push_back({"implicit-euler", SolverSettings{}, true});
-  for (const auto& [method, newton] : {std::pair<const char*, int>{"implicit-euler", 0},
-                                       std::pair<const char*, int>{"implicit-newton", 2}}) {
-    for (Index n : substeps) {
-      for (Real tolerance : tolerances) {
-        for (bool warm : warmStarts) {
-          // In quick mode, cold starts only at the coarsest step: they change little elsewhere.
-          if (options.quick && !warm && n != 1) continue;
-          // Newton costs ~2-5x per step: in quick mode its finest step is left out.
-          if (options.quick && newton > 0 && n > 4) continue;
-          SweepConfig config{method, SolverSettings{}, false};
-          config.solver.substeps = n;
-          config.solver.newtonIterations = newton;
-          // A cap high enough that the tolerance, not the cap, ends the solve (the defaults keep
-          // their 200; a capped solve is still reported as solver-not-converged).
-          config.solver.cgMaxIterations = 1000;
-          config.solver.cgTolerance = tolerance;
-          // The implicit series are the residual test, named so; the default is the velocity
-          // error, which the -verr series sweeps.
-          config.solver.cgStopping = PcgStopping::RelativeResidual;
-          config.solver.tightCgTolerance = 0;  // every substep to cgTolerance: a uniform grid
-          config.solver.warmStart = warm;
-          configs.push_back(config);
-          // The same step with the velocity-error stopping test (SolverSettings::cgStopping); in
-          // quick mode warm starts at the two coarsest steps only.
-          if (newton == 0 && warm && (!options.quick || n <= 2)) {
-            SweepConfig velocity = config;
-            velocity.method = "implicit-euler-verr";
-            velocity.solver.cgStopping = PcgStopping::VelocityError;
-            configs.push_back(velocity);
+  for (IntegratorKind kind : {IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2}) {
+    for (int newton : {0, 1}) {
+      for (Index n : substeps) {
+        // Newton iterations cost about twice a step: their finest step is left out.
+        if (newton > 0 && n > substeps[substeps.size() - 2]) continue;
+        for (PcgStopping stopping : {PcgStopping::VelocityError, PcgStopping::RelativeResidual}) {
+          const bool velocity = stopping == PcgStopping::VelocityError;
+          for (Real tolerance : velocity ? velocityTolerances : residualTolerances) {
+            std::string method = integratorName(kind);
+            if (newton > 0) method += "-newton" + std::to_string(newton);
+            method += velocity ? "-verr" : "-residual";
+            SweepConfig config{method, SolverSettings{}, false};
+            config.solver.integrator = kind;
+            config.solver.substeps = n;
+            config.solver.newtonIterations = newton;
+            config.solver.cgTolerance = tolerance;
+            config.solver.cgStopping = stopping;
+            config.solver.cgMaxIterations = 1000;  // the tolerance, not the cap, ends a solve
+            config.solver.tightCgTolerance = 0;     // every substep at cgTolerance: a uniform grid
+            configs.push_back(config);
           }
         }
       }
     }
   }
-  for (IntegratorKind kind : {IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler,
-                              IntegratorKind::Midpoint, IntegratorKind::RungeKutta4}) {
-    const char* method = integratorName(kind);
-    for (Index n : explicitSubsteps) {
-      SweepConfig config{method, SolverSettings{}, false};
-      config.solver.integrator = kind;
-      config.solver.substeps = n;
-      configs.push_back(config);
-    }
-    // The world's automatic substeps: as many as the stability estimate asks for (~90-130 per
-    // frame on the curtain), capped at maxSubsteps and then flagged. The practical explicit run;
-    // 10-30 s per simulated second, so quick mode keeps only the cheapest (symplectic Euler).
-    if (options.quick && kind != IntegratorKind::SymplecticEuler) continue;
-    SweepConfig config{method, SolverSettings{}, false};
+  for (IntegratorKind kind : {IntegratorKind::SymplecticEuler, IntegratorKind::RungeKutta4,
+                              IntegratorKind::ExplicitEuler, IntegratorKind::Midpoint}) {
+    // The world's automatic substeps (its stability estimate): ~100 per frame on the curtain.
+    if (!options.full && kind != IntegratorKind::SymplecticEuler) continue;
+    SweepConfig config{integratorName(kind), SolverSettings{}, false};
     config.solver.integrator = kind;
     config.solver.substeps = 0;
     configs.push_back(config);
   }
+#if WEFT_HAVE_BULLET
+  if (options.bullet) {
+    for (const auto& [iterations, steps] :
+         {std::pair{1, 1}, std::pair{4, 1}, std::pair{16, 1}, std::pair{64, 1}, std::pair{4, 4},
+          std::pair{16, 4}}) {
+      if (options.quick && steps > 1 && iterations > 4) continue;
+      SweepConfig config{"bullet", SolverSettings{}, false};
+      config.isBullet = true;
+      config.bulletIterations = iterations;
+      config.bulletSubsteps = steps;
+      configs.push_back(config);
+    }
+  }
+#endif
   return configs;
 }
 
-void measureErrors(RunResult& run, const std::vector<Sample>& samples,
-                   const std::vector<Sample>& reference, Real length, Real energyScale) {
-  if (samples.size() != reference.size()) {
-    run.rmsError = run.maxError = run.strainError = run.energyDrift =
-        std::numeric_limits<Real>::quiet_NaN();
-    return;
+// ---- errors ---------------------------------------------------------------------------------
+
+struct Comparison {
+  const ClothModel* model = nullptr;
+  SilhouetteGrid grid;
+  Real length = 1;        // m
+  Real energyScale = 1;   // J, M g L
+  // Per reference sample: its statistics (computed once).
+  std::vector<StrainPercentiles> strains;
+  std::vector<Silhouette> silhouettes;
+};
+
+Comparison prepareComparison(const ClothModel& model, const ClothMaterial& material,
+                             const std::vector<Sample>& reference) {
+  Comparison comparison;
+  comparison.model = &model;
+  comparison.length = model.characteristicLength();
+  comparison.energyScale = model.totalMass(material.arealDensity) * 9.81 * comparison.length;
+  for (const Sample& sample : reference) {
+    comparison.strains.push_back(strainPercentiles(model, sample.positions));
+    comparison.silhouettes.push_back(comparison.grid.rasterize(model.indices(), sample.positions));
   }
-  for (std::size_t k = 0; k < samples.size(); ++k) {
-    Real sumSquares = 0, largest = 0;
-    const std::size_t n = samples[k].positions.size();
-    for (std::size_t i = 0; i < n; ++i) {
-      const Real distance = (samples[k].positions[i] - reference[k].positions[i]).norm();
-      sumSquares += distance * distance;
-      largest = std::max(largest, distance);
-    }
-    run.rmsError = std::max(run.rmsError, std::sqrt(sumSquares / Real(n)) / length);
-    run.maxError = std::max(run.maxError, largest / length);
-    run.strainError = std::max(run.strainError, std::abs(samples[k].maxStrain - reference[k].maxStrain));
-    run.energyDrift = std::max(run.energyDrift, std::abs(samples[k].energy - reference[k].energy) / energyScale);
-  }
+  return comparison;
 }
 
-bool dominates(const RunResult& a, const RunResult& b) {
-  return a.wallPerSimulated <= b.wallPerSimulated && a.rmsError <= b.rmsError &&
-         (a.wallPerSimulated < b.wallPerSimulated || a.rmsError < b.rmsError);
+std::vector<PhaseError> measureErrors(const std::vector<Sample>& samples,
+                                      const std::vector<Sample>& reference,
+                                      const std::vector<Phase>& phases,
+                                      const Comparison& comparison) {
+  std::vector<PhaseError> errors(phases.size());
+  if (samples.size() != reference.size()) return errors;
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    PhaseError& error = errors[p];
+    Real rms = 0, energy = 0, strain = 0, silhouette = 0, contacts = 0, referenceContacts = 0;
+    bool haveEnergy = true, haveContacts = true;
+    for (std::size_t k : phases[p].samples) {
+      const Sample& sample = samples[k];
+      const Sample& truth = reference[k];
+      Real sumSquares = 0;
+      for (std::size_t i = 0; i < sample.positions.size(); ++i) {
+        sumSquares += (sample.positions[i] - truth.positions[i]).squaredNorm();
+      }
+      rms = std::max(rms, std::sqrt(sumSquares / Real(sample.positions.size())));
+      haveEnergy = haveEnergy && std::isfinite(sample.energy);
+      if (haveEnergy) energy += std::abs(sample.energy - truth.energy);
+      const StrainPercentiles percentiles = strainPercentiles(*comparison.model, sample.positions);
+      Real largest = 0;
+      for (std::size_t q = 0; q < percentiles.size(); ++q) {
+        largest = std::max(largest, std::abs(percentiles[q] - comparison.strains[k][q]));
+      }
+      strain += largest;
+      silhouette += silhouetteDistance(
+          comparison.grid.rasterize(comparison.model->indices(), sample.positions),
+          comparison.silhouettes[k]);
+      haveContacts = haveContacts && std::isfinite(sample.contacts);
+      if (haveContacts) {
+        contacts += sample.contacts;
+        referenceContacts += truth.contacts;
+      }
+    }
+    const Real count = Real(phases[p].samples.size());
+    if (count == 0) continue;
+    error.rms = rms / comparison.length;
+    error.energy = haveEnergy ? energy / count / comparison.energyScale : kNaN;
+    error.strain = strain / count;
+    error.silhouette = silhouette / count;
+    error.contacts = haveContacts ? std::abs(contacts - referenceContacts) / count /
+                                        Real(comparison.model->vertexCount())
+                                  : kNaN;
+  }
+  return errors;
 }
+
+// ---- ranking --------------------------------------------------------------------------------
+
+// How one phase is ranked: by vertex distance where the reference resolves it, else by the
+// statistics, each with its floor (kResolution × the reference's own difference to its check).
+struct PhaseVerdict {
+  Real referenceRms = kNaN;         // check vs reference, / L
+  Real referenceStatistics = kNaN;  // check vs reference
+  Real sensitivity = kNaN;          // defaults perturbed by 1 nm vs defaults, rms / L
+  Real smallestRms = kNaN;          // smallest vertex error of a Weft configuration
+  Real smallestStatistics = kNaN;
+  bool byDistance = true;           // ranked by vertex distance (else by statistics)
+  bool chaotic = false;
+  Real floor() const { return kResolution * (byDistance ? referenceRms : referenceStatistics); }
+};
+
+Real rankedError(const RunResult& run, std::size_t phase, const PhaseVerdict& verdict) {
+  if (!run.stable || phase >= run.phases.size()) return kNaN;
+  const Real error = verdict.byDistance ? run.phases[phase].rms : run.phases[phase].statistics();
+  if (!std::isfinite(error)) return kNaN;
+  // Below the floor the reference cannot tell errors apart: they tie at the floor.
+  return std::max(error, verdict.floor());
+}
+
+bool dominates(const RunResult& a, const RunResult& b, std::size_t phase, const PhaseVerdict& verdict) {
+  const Real errorA = rankedError(a, phase, verdict), errorB = rankedError(b, phase, verdict);
+  if (!std::isfinite(errorA) || !std::isfinite(errorB)) return false;
+  return a.cpuPerSimulated <= b.cpuPerSimulated && errorA <= errorB &&
+         (a.cpuPerSimulated < b.cpuPerSimulated || errorA < errorB);
+}
+
+std::vector<std::size_t> paretoFront(const std::vector<RunResult>& runs, std::size_t phase,
+                                     const PhaseVerdict& verdict) {
+  std::vector<std::size_t> front;
+  for (std::size_t k = 0; k < runs.size(); ++k) {
+    if (!std::isfinite(rankedError(runs[k], phase, verdict))) continue;
+    bool dominated = false;
+    for (std::size_t j = 0; j < runs.size() && !dominated; ++j) {
+      dominated = j != k && dominates(runs[j], runs[k], phase, verdict);
+    }
+    if (!dominated) front.push_back(k);
+  }
+  std::sort(front.begin(), front.end(), [&](std::size_t a, std::size_t b) {
+    return runs[a].cpuPerSimulated < runs[b].cpuPerSimulated;
+  });
+  return front;
+}
+
+std::string formatError(Real error, Real floor) {
+  std::ostringstream text;
+  if (!std::isfinite(error)) return "n/a";
+  text << std::setprecision(3) << error;
+  if (error < floor) text << "*";
+  return text.str();
+}
+
+// ---- output ---------------------------------------------------------------------------------
 
 void writeCsv(const std::string& path, const std::vector<RunResult>& runs,
-              const std::vector<bool>& onFront) {
+              const std::vector<Phase>& phases, const std::vector<PhaseVerdict>& verdicts,
+              const std::vector<std::vector<std::size_t>>& fronts) {
   std::ofstream file(path);
-  file << "method,integrator,substeps,h_s,newton_iterations,cg_tolerance,warm_start,defaults,"
-          "status,stable,frames,wall_s_per_sim_s,cg_iterations_per_frame,rms_error,max_error,"
-          "strain_error,energy_drift,pareto\n";
+  file << "configuration,method,integrator,substeps,newton_iterations,cg_stopping,cg_tolerance,"
+          "defaults,bullet,status,stable,frames,cpu_s_per_sim_s,cg_iterations_per_frame,phase,"
+          "rms_error,energy_error,strain_error,contact_error,silhouette_error,statistics_error,"
+          "ranked_by,floor,pareto\n";
   file << std::setprecision(6);
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const RunResult& run = runs[k];
     const SolverSettings& solver = run.config.solver;
-    const bool implicit = solver.integrator == IntegratorKind::ImplicitEuler;
-    file << run.config.method << ',' << integratorName(solver.integrator) << ',' << run.substeps
-         << ',' << CurtainScene::kFrameDt / Real(std::max<Index>(run.substeps, 1)) << ','
-         << (implicit ? solver.newtonIterations : 0) << ',';
-    if (implicit) file << solver.cgTolerance;
-    file << ',' << (implicit ? (solver.warmStart ? "on" : "off") : "") << ','
-         << (run.config.isDefaults ? 1 : 0) << ',' << describe(run.status) << ','
-         << (run.stable ? 1 : 0) << ',' << run.framesRun << ',' << run.wallPerSimulated << ','
-         << run.cgIterationsPerFrame << ',' << run.rmsError << ',' << run.maxError << ','
-         << run.strainError << ',' << run.energyDrift << ',' << (onFront[k] ? 1 : 0) << '\n';
+    for (std::size_t p = 0; p < phases.size(); ++p) {
+      const PhaseError error = p < run.phases.size() ? run.phases[p] : PhaseError{};
+      const bool onFront = std::find(fronts[p].begin(), fronts[p].end(), k) != fronts[p].end();
+      file << '"' << describeConfig(run) << "\"," << run.config.method << ','
+           << (run.config.isBullet ? "bullet" : integratorName(solver.integrator)) << ','
+           << run.substeps << ',' << (run.config.isBullet ? 0 : solver.newtonIterations) << ','
+           << (run.config.isBullet ? ""
+               : solver.cgStopping == PcgStopping::VelocityError ? "velocity-error"
+                                                                   : "relative-residual")
+           << ',' << (run.config.isBullet ? kNaN : solver.cgTolerance) << ','
+           << (run.config.isDefaults ? 1 : 0) << ',' << (run.config.isBullet ? 1 : 0) << ','
+           << describe(run.status) << ',' << (run.stable ? 1 : 0) << ',' << run.framesRun << ','
+           << run.cpuPerSimulated << ',' << run.cgIterationsPerFrame << ",\"" << phases[p].name
+           << "\"," << error.rms << ',' << error.energy << ',' << error.strain << ','
+           << error.contacts << ',' << error.silhouette << ',' << error.statistics() << ','
+           << (verdicts[p].byDistance ? "distance" : "statistics") << ',' << verdicts[p].floor()
+           << ',' << (onFront ? 1 : 0) << '\n';
+    }
   }
 }
 
-// Writes the data and a gnuplot script next to the PNG and runs gnuplot. False when gnuplot is
-// missing or fails; the message says what to do.
+// Writes the data and a gnuplot script next to the PNG and runs gnuplot: one panel per phase,
+// each method a series, the front, the defaults and the reference's floor. False (with a
+// message) when gnuplot is missing or fails; the tables and the CSV do not need it.
 bool writePlot(const std::string& pngPath, const std::vector<RunResult>& runs,
-               const std::vector<bool>& onFront, std::ostream& out) {
-  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
-    out << "plot: gnuplot is not installed; install it with `apt-get install gnuplot-nox` and run "
-           "again (the CSV has every number)\n";
-    return false;
-  }
+               const std::vector<Phase>& phases, const std::vector<PhaseVerdict>& verdicts,
+               const std::vector<std::vector<std::size_t>>& fronts, const std::string& title,
+               std::ostream& out) {
   const std::string dataPath = pngPath + ".dat";
   const std::string scriptPath = pngPath + ".gp";
-  std::map<std::string, std::vector<const RunResult*>> series;
+  std::vector<std::string> methods;
   for (const RunResult& run : runs) {
-    if (run.stable && std::isfinite(run.rmsError) && run.rmsError > 0) series[run.config.method].push_back(&run);
+    if (std::find(methods.begin(), methods.end(), run.config.method) == methods.end()) {
+      methods.push_back(run.config.method);
+    }
   }
   std::ofstream data(dataPath);
   data << std::setprecision(6);
-  std::vector<std::string> titles;
-  for (auto& [method, points] : series) {
-    std::sort(points.begin(), points.end(), [](const RunResult* a, const RunResult* b) {
-      return a->wallPerSimulated < b->wallPerSimulated;
-    });
-    data << "# " << method << "\n";
-    for (const RunResult* run : points) data << run->wallPerSimulated << ' ' << run->rmsError << '\n';
+  // Blocks: per phase, one per method, then the front, then the defaults.
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    for (const std::string& method : methods) {
+      data << "# " << phases[p].name << ": " << method << "\n";
+      for (const RunResult& run : runs) {
+        const Real error = rankedError(run, p, verdicts[p]);
+        if (run.config.method == method && std::isfinite(error)) {
+          data << run.cpuPerSimulated << ' ' << error << '\n';
+        }
+      }
+      data << "\n\n";
+    }
+    data << "# " << phases[p].name << ": front\n";
+    for (std::size_t k : fronts[p]) data << runs[k].cpuPerSimulated << ' ' << rankedError(runs[k], p, verdicts[p]) << '\n';
+    data << "\n\n# " << phases[p].name << ": defaults\n";
+    for (const RunResult& run : runs) {
+      if (run.config.isDefaults && std::isfinite(rankedError(run, p, verdicts[p]))) {
+        data << run.cpuPerSimulated << ' ' << rankedError(run, p, verdicts[p]) << '\n';
+      }
+    }
     data << "\n\n";
-    titles.push_back(method);
   }
-  std::vector<const RunResult*> front, defaults;
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    if (onFront[k]) front.push_back(&runs[k]);
-    if (runs[k].config.isDefaults && runs[k].stable) defaults.push_back(&runs[k]);
-  }
-  std::sort(front.begin(), front.end(), [](const RunResult* a, const RunResult* b) {
-    return a->wallPerSimulated < b->wallPerSimulated;
-  });
-  data << "# pareto\n";
-  for (const RunResult* run : front) data << run->wallPerSimulated << ' ' << run->rmsError << '\n';
-  data << "\n\n# defaults\n";
-  for (const RunResult* run : defaults) data << run->wallPerSimulated << ' ' << run->rmsError << '\n';
-  data << "\n";
   data.close();
-
+  const std::size_t blocksPerPhase = methods.size() + 2;
+  const int columns = phases.size() > 4 ? 3 : 2;
+  const int rows = int((phases.size() + std::size_t(columns) - 1) / std::size_t(columns));
   std::ofstream script(scriptPath);
-  script << "set terminal pngcairo size 1100,750 noenhanced\n"
-         << "set output '" << pngPath << "'\n"
-         << "set logscale xy\nset grid\nset key outside right\n"
-         << "set title 'Weft curtain: error vs wall time (reference: backward Euler, h/16)'\n"
-         << "set xlabel 'wall time per simulated second [s]'\n"
-         << "set ylabel 'RMS vertex error / characteristic length'\n"
-         << "plot ";
-  for (std::size_t k = 0; k < titles.size(); ++k) {
-    script << "'" << dataPath << "' index " << k << " with points pt 7 ps 1.3 title '" << titles[k] << "', ";
+  script << "set terminal pngcairo size " << 700 * columns << "," << 520 * rows
+         << " noenhanced font ',10'\nset output '" << pngPath << "'\n"
+         << "set multiplot layout " << rows << "," << columns << " title '" << title << "'\n"
+         << "set logscale xy\nset grid\nset key bottom left font ',8'\n"
+         << "set xlabel 'CPU s per simulated s (1 thread)'\n";
+  const char* points[] = {"pt 7", "pt 5", "pt 9", "pt 11", "pt 13", "pt 2", "pt 3", "pt 4",
+                          "pt 6", "pt 8", "pt 10", "pt 12"};
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    script << "set title '" << phases[p].name << " (" << phases[p].begin << "-" << phases[p].end
+           << " s), by " << (verdicts[p].byDistance ? "RMS vertex distance / L" : "shape statistics")
+           << (verdicts[p].chaotic ? ", chaotic" : "") << "'\n"
+           << "set ylabel '" << (verdicts[p].byDistance ? "RMS error / L" : "statistics error")
+           << "'\nplot ";
+    for (std::size_t m = 0; m < methods.size(); ++m) {
+      script << "'" << dataPath << "' index " << p * blocksPerPhase + m << " with points "
+             << points[m % 12] << " ps 1.1 title '" << methods[m] << "', ";
+    }
+    script << "'" << dataPath << "' index " << p * blocksPerPhase + methods.size()
+           << " with steps lw 2 lc rgb 'black' title 'front', '" << dataPath << "' index "
+           << p * blocksPerPhase + methods.size() + 1
+           << " with points pt 6 ps 3 lw 2 lc rgb 'red' title 'SolverSettings{}', "
+           << verdicts[p].floor() << " with lines dt 2 lc rgb 'gray' title 'reference floor (10x)'\n";
   }
-  script << "'" << dataPath << "' index " << titles.size()
-         << " with steps lw 2 lc rgb 'black' title 'Pareto front', '" << dataPath << "' index "
-         << titles.size() + 1 << " with points pt 6 ps 3 lw 2 lc rgb 'red' title 'SolverSettings{}'\n";
+  script << "unset multiplot\n";
   script.close();
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0) {
+    out << "plot: gnuplot is not installed (apt-get install gnuplot-nox); its data and script are "
+        << dataPath << " and " << scriptPath << "\n";
+    return false;
+  }
   const std::string command = "gnuplot '" + scriptPath + "'";
   if (std::system(command.c_str()) != 0) {
     out << "plot: gnuplot failed on " << scriptPath << "\n";
@@ -454,11 +682,83 @@ bool writePlot(const std::string& pngPath, const std::vector<RunResult>& runs,
   return true;
 }
 
+std::optional<IntegratorKind> implicitIntegratorFromName(const std::string& name) {
+  for (IntegratorKind kind : {IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2}) {
+    if (name == integratorName(kind)) return kind;
+  }
+  return std::nullopt;
+}
+
+// A reference of the given substeps, read from the cache or computed (and cached).
+bool obtainReference(const ErrorTimeOptions& options, IntegratorKind integrator, Index substeps,
+                     const std::vector<Index>& sampleFrames, const std::string& cacheSuffix,
+                     EnergyProbe& probe, Index vertexCount, std::vector<Sample>& samples,
+                     std::ostream& out) {
+  SweepConfig config{"reference", SolverSettings{}, false};
+  config.solver.integrator = integrator;
+  config.solver.substeps = substeps;
+  config.solver.newtonIterations = options.referenceNewtonIterations;
+  config.solver.cgTolerance = options.referenceCgTolerance;
+  config.solver.cgStopping = PcgStopping::RelativeResidual;
+  config.solver.tightCgTolerance = 0;
+  config.solver.cgMaxIterations = 5000;
+  std::ostringstream keyText;
+  keyText << std::setprecision(17) << "weft-error-time reference v2; curtain x1; vertices "
+          << vertexCount << "; " << integratorName(integrator) << " substeps " << substeps
+          << " newton " << options.referenceNewtonIterations << " cg "
+          << options.referenceCgTolerance << "; frames";
+  for (Index frame : sampleFrames) keyText << ' ' << frame;
+  {
+    // Engine fingerprint: the state hash after the reference's first two frames.
+    CurtainSettings settings;
+    settings.solver = config.solver;
+    settings.threadCount = 1;
+    CurtainScene scene = CurtainScene::create(settings).value();
+    for (int frame = 0; frame < 2; ++frame) scene.stepFrame();
+    keyText << "; engine fingerprint " << std::hex << scene.world().stateHash() << std::dec;
+  }
+  const std::string path = options.referenceCache.empty() ? "" : options.referenceCache + cacheSuffix;
+  std::string why = "no --reference-cache given";
+  if (!path.empty()) samples = loadReference(path, keyText.str(), why);
+  const std::string name = std::string(integratorName(integrator)) + " h=1/" +
+                           std::to_string(std::lround(Real(substeps) / CurtainScene::kFrameDt));
+  if (!samples.empty()) {
+    out << "  " << name << " read from " << path << "\n";
+    return true;
+  }
+  out << "  " << name << " computing (" << why << "), " << options.referenceNewtonIterations
+      << " Newton iterations, PCG to " << options.referenceCgTolerance << " ..." << std::flush;
+  const Clock::time_point start = Clock::now();
+  const RunResult run = runCurtain(config, sampleFrames, samples, probe);
+  out << " " << std::setprecision(4) << std::chrono::duration<double>(Clock::now() - start).count()
+      << " s, " << std::setprecision(4) << run.cgIterationsPerFrame << " CG/frame, status "
+      << describe(run.status) << "\n";
+  if (!run.stable) {
+    out << "weft-error-time: the reference run is not healthy (" << describe(run.status)
+        << "); change --reference-substeps\n";
+    return false;
+  }
+  if (!path.empty()) {
+    out << "  " << name << (saveReference(path, keyText.str(), samples) ? " cached in " : " could not be written to ")
+        << path << "\n";
+  }
+  return true;
+}
+
 }  // namespace
 
 int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
+  if (options.scene == "drape" || options.scene == "pendulum") return runIntegratorStudy(options, out);
   if (options.scene != "curtain") {
-    out << "weft-error-time: scene '" << options.scene << "' is unknown; the only scene is curtain\n";
+    out << "weft-error-time: scene '" << options.scene
+        << "' is unknown; choose curtain, drape or pendulum\n";
+    return 2;
+  }
+  const std::optional<IntegratorKind> referenceIntegrator =
+      implicitIntegratorFromName(options.referenceIntegrator);
+  if (!referenceIntegrator) {
+    out << "weft-error-time: --reference-integrator '" << options.referenceIntegrator
+        << "' is not an implicit integrator; choose implicit-euler or bdf2\n";
     return 2;
   }
   for (const std::string& path :
@@ -473,79 +773,46 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
       return 2;
     }
   }
-  const Index size = 1;
-  // Sample times: settle (0.5 s, 1 s), the curtain swinging back (2 s); --full adds the rod
-  // gathering the curtain (5 s, 6 s).
-  const std::vector<Real> sampleTimes =
-      options.full ? std::vector<Real>{0.5, 1.0, 2.0, 5.0, 6.0} : std::vector<Real>{0.5, 1.0, 2.0};
+  // Samples every 0.1 s: the first 3 s (settle, push, withdraw) quick, 6 s (through the gather)
+  // by default, the whole script with --full.
+  const Real endTime = options.quick ? 3.0 : options.full ? 10.0 : 6.0;
   std::vector<Index> sampleFrames;
-  for (Real t : sampleTimes) sampleFrames.push_back(Index(std::lround(t / CurtainScene::kFrameDt)));
+  for (Index frame = kSampleEveryFrames; Real(frame) * CurtainScene::kFrameDt <= endTime + 1e-9;
+       frame += kSampleEveryFrames) {
+    sampleFrames.push_back(frame);
+  }
+  std::vector<Phase> phases;
+  for (const CurtainPhase& phase : CurtainScene::phases()) {
+    if (phase.begin >= endTime - 1e-9) break;
+    Phase entry{phase.name, phase.begin, std::min(phase.end, endTime), {}};
+    for (std::size_t k = 0; k < sampleFrames.size(); ++k) {
+      const Real t = Real(sampleFrames[k]) * CurtainScene::kFrameDt;
+      if (t > entry.begin + 1e-9 && t <= entry.end + 1e-9) entry.samples.push_back(k);
+    }
+    phases.push_back(entry);
+  }
 
   const CurtainScene probeScene = CurtainScene::create().value();
   const std::shared_ptr<const ClothModel> model = probeScene.sharedModel();
   const ClothMaterial material = CurtainSettings{}.material;
   EnergyProbe probe(model, material);
-  const Real length = model->characteristicLength();
-  const Real energyScale = model->totalMass(material.arealDensity) * 9.81 * length;
+  out << "Weft error-vs-time sweep, curtain x1: " << model->vertexCount() << " vertices, "
+      << "characteristic length L = " << model->characteristicLength() << " m; " << sampleFrames.size()
+      << " samples every 0.1 s to " << endTime << " s, in " << phases.size() << " phases\n"
+      << "Cost: CPU time of the stepping thread per simulated second, one thread (the machine is "
+         "shared: thread CPU time, not wall time)\n";
 
-  out << "Weft error-vs-time sweep, curtain size x" << size << ": "
-      << model->vertexCount() << " vertices, characteristic length " << length << " m\n"
-      << "  samples at";
-  for (Real t : sampleTimes) out << ' ' << t << " s";
-  out << " (pin script on)\n";
-
-  // The reference.
-  SweepConfig referenceConfig{"reference", SolverSettings{}, false};
-  referenceConfig.solver.substeps = options.referenceSubsteps;
-  referenceConfig.solver.newtonIterations = options.referenceNewtonIterations;
-  referenceConfig.solver.cgTolerance = options.referenceCgTolerance;
-  referenceConfig.solver.cgStopping = PcgStopping::RelativeResidual;  // the reference: residual ≤ 1e-10
-  referenceConfig.solver.tightCgTolerance = 0;  // every substep to the reference's tolerance
-  referenceConfig.solver.cgMaxIterations = 5000;
-  std::ostringstream keyText;
-  keyText << std::setprecision(17) << "weft-error-time reference v1; curtain size " << size
-          << "; vertices " << model->vertexCount() << "; implicit-euler substeps "
-          << options.referenceSubsteps << " newton " << options.referenceNewtonIterations
-          << " cg " << options.referenceCgTolerance << "; frames";
-  for (Index frame : sampleFrames) keyText << ' ' << frame;
-  {
-    // Engine fingerprint: the state hash after the reference's first two frames. Any change of
-    // the engine or the scene that alters the reference changes it, so a stale cache is never
-    // read back (about 2 % of the reference's cost).
-    CurtainSettings settings;
-    settings.size = size;
-    settings.solver = referenceConfig.solver;
-    CurtainScene scene = CurtainScene::create(settings).value();
-    for (int frame = 0; frame < 2; ++frame) scene.stepFrame();
-    keyText << "; engine fingerprint " << std::hex << scene.world().stateHash() << std::dec;
+  // The reference and its check at half the step.
+  std::vector<Sample> reference, check;
+  out << "reference\n";
+  if (!obtainReference(options, *referenceIntegrator, options.referenceSubsteps, sampleFrames, ".ref",
+                       probe, model->vertexCount(), reference, out) ||
+      !obtainReference(options, *referenceIntegrator, 2 * options.referenceSubsteps, sampleFrames,
+                       ".check", probe, model->vertexCount(), check, out)) {
+    return 1;
   }
-  const std::string key = keyText.str();
-  std::vector<Sample> reference;
-  std::string why = "no --reference-cache given";
-  if (!options.referenceCache.empty()) reference = loadReference(options.referenceCache, key, why);
-  if (!reference.empty()) {
-    out << "  reference  read from " << options.referenceCache << "\n";
-  } else {
-    out << "  reference  computing (" << why << "): backward Euler, " << options.referenceSubsteps
-        << " substeps per frame, " << options.referenceNewtonIterations
-        << " Newton iterations, PCG to " << options.referenceCgTolerance << " ..." << std::flush;
-    const Clock::time_point start = Clock::now();
-    const RunResult run = runCurtain(referenceConfig, sampleFrames, &reference, probe, size);
-    out << " " << std::chrono::duration<double>(Clock::now() - start).count() << " s, status "
-        << describe(run.status) << "\n";
-    if (!run.stable) {
-      out << "weft-error-time: the reference run is not healthy (" << describe(run.status)
-          << "); raise --reference-substeps\n";
-      return 1;
-    }
-    if (!options.referenceCache.empty()) {
-      if (saveReference(options.referenceCache, key, reference)) {
-        out << "  reference  cached in " << options.referenceCache << "\n";
-      } else {
-        out << "  reference  could not be written to " << options.referenceCache << "\n";
-      }
-    }
-  }
+  const Comparison comparison = prepareComparison(*model, material, reference);
+  const std::vector<PhaseError> referenceErrors = measureErrors(check, reference, phases, comparison);
 
   // The sweep.
   std::vector<SweepConfig> configs = sweepConfigs(options);
@@ -557,160 +824,193 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
       return !config.isDefaults && describeConfig(run).find(options.only) == std::string::npos;
     });
   }
-  out << "  sweep      " << configs.size() << " runs\n";
+  out << "sweep: " << configs.size() << " runs\n";
   std::vector<RunResult> runs;
-  // Substeps the world picks for each explicit method on its own (its stability estimate).
-  std::map<IntegratorKind, Index> stableSubsteps;
+  std::vector<Sample> samples;
   for (const SweepConfig& config : configs) {
-    const IntegratorKind kind = config.solver.integrator;
-    if (kind == IntegratorKind::ImplicitEuler || stableSubsteps.count(kind)) continue;
-    CurtainSettings settings;
-    settings.size = size;
-    settings.solver.integrator = kind;
-    const CurtainScene scene = CurtainScene::create(settings).value();
-    stableSubsteps[kind] = scene.world().plannedSubsteps(scene.cloth(), CurtainScene::kFrameDt).value();
-  }
-  for (const SweepConfig& config : configs) {
-    std::vector<Sample> samples;
-    const auto stable = stableSubsteps.find(config.solver.integrator);
-    if (options.quick && stable != stableSubsteps.end() && config.solver.substeps != 0 &&
-        config.solver.substeps < stable->second) {
-      // Quick mode does not run what the world predicts unstable: the engine's roll-back and
-      // retry make even one frame of it cost tens of seconds. It is reported as unstable.
-      RunResult run;
-      run.config = config;
-      run.substeps = config.solver.substeps;
-      run.status = StepStatus::Unstable;
-      run.stable = false;
-      run.rmsError = run.maxError = run.strainError = run.energyDrift =
-          std::numeric_limits<Real>::quiet_NaN();
-      if (options.progress) {
-        out << "  " << std::left << std::setw(52) << describeConfig(run) << std::right
-            << " predicted unstable (needs " << stable->second << " substeps), not run\n";
-      }
-      runs.push_back(std::move(run));
-      continue;
-    }
-    RunResult run = runCurtain(config, sampleFrames, &samples, probe, size);
-    measureErrors(run, samples, reference, length, energyScale);
-    // Repeats only re-time: the same settings give the same bits, so errors do not change.
+    RunResult run;
+#if WEFT_HAVE_BULLET
+    if (config.isBullet) run = runBullet(config, sampleFrames, samples);
+    else run = runCurtain(config, sampleFrames, samples, probe);
+#else
+    run = runCurtain(config, sampleFrames, samples, probe);
+#endif
+    run.phases = measureErrors(samples, reference, phases, comparison);
+    // Repeats only re-time: the same settings give the same bits.
     for (int repeat = 1; repeat < options.repeats && run.stable; ++repeat) {
       std::vector<Sample> again;
-      const RunResult rerun = runCurtain(config, sampleFrames, &again, probe, size);
-      run.wallPerSimulated = std::min(run.wallPerSimulated, rerun.wallPerSimulated);
+#if WEFT_HAVE_BULLET
+      const RunResult rerun = config.isBullet ? runBullet(config, sampleFrames, again)
+                                              : runCurtain(config, sampleFrames, again, probe);
+#else
+      const RunResult rerun = runCurtain(config, sampleFrames, again, probe);
+#endif
+      run.cpuPerSimulated = std::min(run.cpuPerSimulated, rerun.cpuPerSimulated);
     }
     if (options.progress) {
-      out << "  " << std::left << std::setw(52) << describeConfig(run) << std::right
-          << " time " << std::setw(8) << std::setprecision(3) << run.wallPerSimulated
-          << " s/s  rms " << std::setw(9) << std::setprecision(3) << run.rmsError << "  "
-          << describe(run.status) << "\n"
-          << std::flush;
+      out << "  " << std::left << std::setw(58) << describeConfig(run) << std::right << " cpu "
+          << std::setw(7) << std::setprecision(3) << run.cpuPerSimulated << " s/s  rms";
+      for (const PhaseError& error : run.phases) out << ' ' << std::setw(9) << std::setprecision(3) << error.rms;
+      out << "  " << describe(run.status) << "\n" << std::flush;
     }
     runs.push_back(std::move(run));
   }
 
-  // Pareto front over stable runs: wall time against RMS error.
-  std::vector<bool> onFront(runs.size(), false);
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    if (!runs[k].stable || !std::isfinite(runs[k].rmsError)) continue;
-    onFront[k] = true;
-    for (std::size_t j = 0; j < runs.size(); ++j) {
-      if (j != k && runs[j].stable && std::isfinite(runs[j].rmsError) && dominates(runs[j], runs[k])) {
-        onFront[k] = false;
-        break;
+  // Sensitivity: a run without switches in its solver (backward Euler at 1/60 s, every solve to
+  // the residual 1e-8) from the curtain's start and from a start moved by 1 nm. Where that grows
+  // to the errors ranked, the cloth's own motion (contact decisions, buckling) amplifies any
+  // difference, and vertex distances rank chance.
+  SweepConfig smoothConfig{"sensitivity", SolverSettings{}, false};
+  smoothConfig.solver.substeps = 1;
+  smoothConfig.solver.cgTolerance = 1e-8;
+  smoothConfig.solver.cgStopping = PcgStopping::RelativeResidual;
+  smoothConfig.solver.tightCgTolerance = 0;
+  smoothConfig.solver.cgMaxIterations = 2000;
+  std::vector<Sample> unperturbed, perturbed;
+  runCurtain(smoothConfig, sampleFrames, unperturbed, probe);
+  runCurtain(smoothConfig, sampleFrames, perturbed, probe, 1e-9);
+  const std::vector<PhaseError> sensitivity = measureErrors(perturbed, unperturbed, phases, comparison);
+
+  // Per phase: what the reference resolves, and how the phase is ranked.
+  std::vector<PhaseVerdict> verdicts(phases.size());
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    PhaseVerdict& verdict = verdicts[p];
+    verdict.referenceRms = referenceErrors[p].rms;
+    verdict.referenceStatistics = referenceErrors[p].statistics();
+    verdict.sensitivity = p < sensitivity.size() ? sensitivity[p].rms : kNaN;
+    for (const RunResult& run : runs) {
+      if (!run.stable || run.config.isBullet || p >= run.phases.size()) continue;
+      const Real rms = run.phases[p].rms, statistics = run.phases[p].statistics();
+      if (std::isfinite(rms)) verdict.smallestRms = std::isfinite(verdict.smallestRms) ? std::min(verdict.smallestRms, rms) : rms;
+      if (std::isfinite(statistics)) {
+        verdict.smallestStatistics = std::isfinite(verdict.smallestStatistics)
+                                         ? std::min(verdict.smallestStatistics, statistics)
+                                         : statistics;
       }
     }
+    // Chaotic: a 1 nm change grows to a tenth of the smallest error ranked.
+    verdict.chaotic = verdict.sensitivity >= 0.1 * verdict.smallestRms;
+    // By distance unless the reference's floor lies above the median configuration's error or
+    // the phase is chaotic (then vertex distances rank chance).
+    std::vector<Real> errors;
+    for (const RunResult& run : runs) {
+      if (run.stable && !run.config.isBullet && p < run.phases.size() && std::isfinite(run.phases[p].rms)) {
+        errors.push_back(run.phases[p].rms);
+      }
+    }
+    std::sort(errors.begin(), errors.end());
+    const Real median = errors.empty() ? kNaN : errors[errors.size() / 2];
+    verdict.byDistance = !verdict.chaotic && kResolution * verdict.referenceRms <= median;
   }
-  std::vector<std::size_t> frontOrder;
-  for (std::size_t k = 0; k < runs.size(); ++k) {
-    if (onFront[k]) frontOrder.push_back(k);
-  }
-  std::sort(frontOrder.begin(), frontOrder.end(), [&](std::size_t a, std::size_t b) {
-    return runs[a].wallPerSimulated < runs[b].wallPerSimulated;
-  });
-  out << "\nPareto front (stable runs; error = RMS vertex distance / " << length << " m):\n";
-  out << "  " << std::left << std::setw(52) << "configuration" << std::right << std::setw(11)
-      << "s per sim s" << std::setw(11) << "rms error" << std::setw(11) << "max error"
-      << std::setw(13) << "strain error" << std::setw(13) << "energy drift" << std::setw(9)
-      << "CG/frame" << "\n";
-  for (std::size_t k : frontOrder) {
-    const RunResult& run = runs[k];
-    out << "  " << std::left << std::setw(52) << describeConfig(run) << std::right
-        << std::setprecision(3) << std::setw(11) << run.wallPerSimulated << std::setw(11)
-        << run.rmsError << std::setw(11) << run.maxError << std::setw(13) << run.strainError
-        << std::setw(13) << run.energyDrift << std::setw(9) << std::setprecision(4)
-        << run.cgIterationsPerFrame << "\n";
-  }
-  int unstable = 0;
-  for (const RunResult& run : runs) unstable += run.stable ? 0 : 1;
-  out << "  (" << unstable << " of " << runs.size()
-      << " runs reported Unstable or RolledBack and are left out; see the CSV)\n";
+  std::vector<std::vector<std::size_t>> fronts;
+  for (std::size_t p = 0; p < phases.size(); ++p) fronts.push_back(paretoFront(runs, p, verdicts[p]));
 
-  // Where SolverSettings{} sits.
+  // The reference's convergence, per phase.
+  std::ostringstream tables;
+  tables << "\nReference: " << options.referenceIntegrator << " at h = 1/"
+         << std::lround(Real(options.referenceSubsteps) / CurtainScene::kFrameDt) << " s, "
+         << options.referenceNewtonIterations << " Newton iterations, PCG residual "
+         << options.referenceCgTolerance << "; check: the same at h/2.\n"
+         << "A phase is ranked by vertex distance where the check's distance to the reference (its "
+            "floor x" << kResolution << ") lies below the errors ranked; errors below the floor "
+            "tie there (marked *).\n\n";
+  tables << "| phase | s | reference vs check: RMS / L | statistics | 1 nm perturbation grows to (RMS / L) | smallest Weft RMS / L | smallest / reference | ranked by |\n"
+         << "|---|---|---:|---:|---:|---:|---:|---|\n";
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    const PhaseVerdict& verdict = verdicts[p];
+    tables << "| " << phases[p].name << " | " << phases[p].begin << "-" << phases[p].end << " | "
+           << std::setprecision(3) << verdict.referenceRms << " | " << verdict.referenceStatistics
+           << " | " << verdict.sensitivity << " | " << verdict.smallestRms << " | "
+           << std::setprecision(3) << verdict.smallestRms / verdict.referenceRms << " | "
+           << (verdict.byDistance ? "vertex distance"
+                                  : std::string("statistics") + (verdict.chaotic ? " (chaotic)" : " (reference unresolved)"))
+           << " |\n";
+  }
+
+  // The fronts, per phase.
+  for (std::size_t p = 0; p < phases.size(); ++p) {
+    const PhaseVerdict& verdict = verdicts[p];
+    tables << "\n### " << phases[p].name << " (" << phases[p].begin << "-" << phases[p].end
+           << " s): Pareto front by " << (verdict.byDistance ? "RMS vertex distance / L" : "shape statistics")
+           << ", floor " << std::setprecision(3) << verdict.floor() << "\n\n"
+           << "| configuration | CPU s per sim s | CG per frame | RMS / L | energy | strain | contacts | silhouette |\n"
+           << "|---|---:|---:|---:|---:|---:|---:|---:|\n";
+    const Real distanceFloor = kResolution * verdict.referenceRms;
+    const Real statisticsFloor = kResolution * verdict.referenceStatistics;
+    for (std::size_t k : fronts[p]) {
+      const RunResult& run = runs[k];
+      const PhaseError& error = run.phases[p];
+      tables << "| " << describeConfig(run) << " | " << std::setprecision(3) << run.cpuPerSimulated
+             << " | " << std::setprecision(4) << run.cgIterationsPerFrame << " | "
+             << formatError(error.rms, distanceFloor) << " | " << formatError(error.energy, statisticsFloor)
+             << " | " << formatError(error.strain, statisticsFloor) << " | "
+             << formatError(error.contacts, statisticsFloor) << " | "
+             << formatError(error.silhouette, statisticsFloor) << " |\n";
+    }
+  }
+
+  // Where the defaults sit, per phase.
+  int status = 0;
+  tables << "\n### Where SolverSettings{} sits\n\n";
   for (std::size_t k = 0; k < runs.size(); ++k) {
     if (!runs[k].config.isDefaults) continue;
     const RunResult& defaults = runs[k];
-    out << "\nSolverSettings{} (" << describeConfig(defaults) << "): "
-        << std::setprecision(3) << defaults.wallPerSimulated << " s per simulated s, rms error "
-        << defaults.rmsError << ", status " << describe(defaults.status) << "\n";
-    if (!defaults.stable) {
-      out << "  the defaults are not stable on the curtain\n";
-    } else if (onFront[k]) {
-      out << "  ON the Pareto front: no run was both faster and more accurate\n";
-    } else {
-      out << "  NOT on the Pareto front; dominated by:\n";
-      bool beyondNoise = false;
-      for (std::size_t j : frontOrder) {
-        if (!dominates(runs[j], defaults)) continue;
-        const Real timeRatio = runs[j].wallPerSimulated / defaults.wallPerSimulated;
-        const Real errorRatio = runs[j].rmsError / defaults.rmsError;
-        out << "    " << describeConfig(runs[j]) << ": " << std::setprecision(3) << timeRatio
-            << "x the time, " << errorRatio << "x the error\n";
-        // Beyond noise: clearly faster (> 10 %) at no worse error, or clearly more accurate
-        // (> 10 %) at no more time.
-        beyondNoise = beyondNoise || timeRatio < 0.9 || errorRatio < 0.9;
+    tables << describeConfig(defaults) << ": " << std::setprecision(3) << defaults.cpuPerSimulated
+           << " CPU s per simulated s, " << std::setprecision(4) << defaults.cgIterationsPerFrame
+           << " CG per frame, status " << describe(defaults.status) << "\n\n";
+    for (std::size_t p = 0; p < phases.size(); ++p) {
+      const bool onFront = std::find(fronts[p].begin(), fronts[p].end(), k) != fronts[p].end();
+      tables << "- " << phases[p].name << ": ";
+      if (!defaults.stable) {
+        tables << "not stable\n";
+        continue;
       }
-      out << (beyondNoise ? "  -> dominated by more than the timing noise (10 %): the defaults "
-                            "should move\n"
-                          : "  -> only within the timing noise (10 %): on the front as far as "
-                            "this run can tell\n");
+      if (onFront) {
+        tables << "on the front\n";
+        continue;
+      }
+      bool beyondNoise = false;
+      std::ostringstream by;
+      for (std::size_t j : fronts[p]) {
+        if (!dominates(runs[j], defaults, p, verdicts[p])) continue;
+        const Real timeRatio = runs[j].cpuPerSimulated / defaults.cpuPerSimulated;
+        const Real errorRatio = rankedError(runs[j], p, verdicts[p]) / rankedError(defaults, p, verdicts[p]);
+        by << "; " << describeConfig(runs[j]) << " (" << std::setprecision(3) << timeRatio
+           << "x the CPU time, " << errorRatio << "x the error)";
+        beyondNoise = beyondNoise || timeRatio < 1 - kTimingNoise || errorRatio < 1 - kTimingNoise;
+      }
+      tables << (beyondNoise ? "DOMINATED beyond the noise" : "dominated only within the noise (10 %)")
+             << by.str() << "\n";
+      if (beyondNoise && verdicts[p].byDistance && options.checkDefaults) status = 3;
     }
   }
-  out << "\nNote: the reference is first order (backward Euler, h/" << options.referenceSubsteps
-      << "); errors well below the reference's own error measure distance to it, not to the exact "
-         "solution. Wall times are single runs on a shared machine: differences under ~10 % are "
-         "noise (use --repeat to keep the fastest of several runs).\n";
+  tables << "\nErrors divided by L = " << comparison.length
+         << " m where they are lengths; statistics are dimensionless (energy / (M g L), strain, "
+            "contacts per vertex, 1 - silhouette IoU). Bullet (bullet piterations=...) runs its "
+            "own cloth model: its errors include the model's difference, not only its "
+            "integrator's.\n";
+  out << tables.str();
 
   if (!options.csvPath.empty()) {
-    writeCsv(options.csvPath, runs, onFront);
+    writeCsv(options.csvPath, runs, phases, verdicts, fronts);
     out << "csv: " << options.csvPath << "\n";
   }
-  if (!options.plotPath.empty()) writePlot(options.plotPath, runs, onFront, out);
   if (!options.markdownPath.empty()) {
     std::ofstream markdown(options.markdownPath);
-    markdown << "| configuration | s per simulated s | RMS error | max error | strain error | "
-                "energy drift | CG per frame |\n|---|---:|---:|---:|---:|---:|---:|\n";
-    for (std::size_t k : frontOrder) {
-      const RunResult& run = runs[k];
-      markdown << "| " << describeConfig(run) << " | " << std::setprecision(3)
-               << run.wallPerSimulated << " | " << run.rmsError << " | " << run.maxError << " | "
-               << run.strainError << " | " << run.energyDrift << " | " << std::setprecision(4)
-               << run.cgIterationsPerFrame << " |\n";
-    }
-    for (std::size_t k = 0; k < runs.size(); ++k) {
-      if (!runs[k].config.isDefaults) continue;
-      markdown << "\nSolverSettings{} (" << describeConfig(runs[k]) << "): " << std::setprecision(3)
-               << runs[k].wallPerSimulated << " s per simulated s, RMS error " << runs[k].rmsError
-               << ", " << (onFront[k] ? "on the Pareto front" : "not on the Pareto front") << ".\n";
-    }
-    markdown << "\nError = distance to the backward-Euler reference at h/" << options.referenceSubsteps
-             << " divided by the cloth's " << length << " m; " << runs.size() << " runs, "
-             << unstable << " unstable left out. Wall times are single runs"
-             << (options.repeats > 1 ? " (fastest of several)" : "")
-             << " on a shared machine: differences under ~10 % are noise.\n";
+    markdown << tables.str();
     out << (markdown ? "markdown: " : "markdown: could not write ") << options.markdownPath << "\n";
   }
-  return 0;
+  if (!options.plotPath.empty()) {
+    std::ostringstream title;
+    title << "Weft curtain: error vs CPU time per phase (reference " << options.referenceIntegrator
+          << " h=1/" << std::lround(Real(options.referenceSubsteps) / CurtainScene::kFrameDt) << ")";
+    writePlot(options.plotPath, runs, phases, verdicts, fronts, title.str(), out);
+  }
+  if (status == 3) {
+    out << "weft-error-time: SolverSettings{} is dominated beyond the timing noise in a phase the "
+           "reference resolves (--check-defaults)\n";
+  }
+  return status;
 }
 
 }  // namespace weft

@@ -44,11 +44,19 @@ int main(int argc, char** argv) {
   for (weft::IntegratorKind kind :
        {weft::IntegratorKind::ImplicitEuler, weft::IntegratorKind::ExplicitEuler,
         weft::IntegratorKind::SymplecticEuler, weft::IntegratorKind::Midpoint,
-        weft::IntegratorKind::RungeKutta4}) {
+        weft::IntegratorKind::RungeKutta4, weft::IntegratorKind::Bdf2}) {
     integrators.emplace(weft::integratorName(kind), kind);
   }
   app.add_option("--integrator", options.integrator, "Time integrator")
       ->transform(CLI::CheckedTransformer(integrators, CLI::ignore_case));
+  app.add_option("--fabric", options.fabric,
+                 "Fabric preset of the curtain: cotton, wool, polyester, silk, denim or linen")
+      ->check(CLI::IsMember({"cotton", "wool", "polyester", "silk", "denim", "linen"}));
+  app.add_flag("--stiffening", options.stiffening,
+               "The preset with its KES tensile test: stretch stiffening past a knee, limit at EMT");
+  app.add_option("--strain-limit", options.strainLimit,
+                 "Strain limit instead of the preset's (0 = off)")
+      ->check(CLI::Range(0.0, 10.0));
   std::string overlap = "on";
   app.add_option("--overlap", overlap, "Render frame k while simulating frame k+1: on or off")
       ->check(CLI::IsMember({"on", "off"}));

@@ -3,6 +3,7 @@
 #include "forces/BaraffWitkin.h"
 #include "forces/IsometricBending.h"
 #include "forces/SpringCondition.h"
+#include "forces/StretchLaw.h"
 
 #include <weft/threading/GrainSizes.h>
 
@@ -89,8 +90,12 @@ ClothForces::ClothForces(const ClothModel& model, const ClothForceSettings& sett
   if (settings.model == ForceModel::BaraffWitkin) {
     m_triangles.reserve(model.triangles().size());
     for (const TriangleRest& triangle : model.triangles()) {
-      Element<3> element{triangle.vertices, {}, Index(m_triangles.size())};
+      TriangleElement element;
+      element.vertices = triangle.vertices;
+      element.modelIndex = Index(m_triangles.size());
       noSlots(element.slots);
+      element.membrane = makeStretchShearRest(triangle, settings.material.warpRestScale,
+                                              settings.material.weftRestScale);
       m_triangles.push_back(element);
     }
     m_bending = settings.material.bendingStiffness != 0 || settings.material.bendingDamping != 0 ||
@@ -287,9 +292,20 @@ void ClothForces::bindMatrix(const BlockSparseMatrix& matrix, const FreeVertexMa
       m_bendingEntries[k].slot = slotOf(row, m_bendingEntries[k].column);
     }
   }
+  m_slotBending.assign(m_isometricBending ? matrix.blockCount() : 0, 0);
+  for (Index vertex = 0; vertex + 1 < Index(m_bendingRowOffsets.size()); ++vertex) {
+    for (Index k = m_bendingRowOffsets[vertex]; k < m_bendingRowOffsets[vertex + 1]; ++k) {
+      const BendingEntry& entry = m_bendingEntries[k];
+      if (entry.slot < m_couplingBase) m_slotBending[entry.slot] = entry.value;
+    }
+  }
   m_diagonalSlots.resize(m_masses.size());
+  m_rowSlots.resize(m_masses.size());
   for (Index i = 0; i < m_masses.size(); ++i) {
-    m_diagonalSlots[i] = map.row(i) == kInvalidIndex ? kInvalidIndex : matrix.diagonalSlot(map.row(i));
+    const Index row = map.row(i);
+    m_diagonalSlots[i] = row == kInvalidIndex ? kInvalidIndex : matrix.diagonalSlot(row);
+    m_rowSlots[i] = row == kInvalidIndex ? std::array<Index, 2>{0, 0}
+                                         : std::array<Index, 2>{matrix.rowBegin(row), matrix.rowEnd(row)};
   }
 }
 
@@ -319,6 +335,23 @@ void scatter(const ElementType& element, const ElementForces<N>& local, const Pa
   }
 }
 
+// Adds one triangle's stretchShear() terms: its forces, and in a Jacobian pass its share of
+// (∂f/∂x)·u and its nine blocks.
+template <typename ElementType, typename PassType>
+void scatterStretchShear(const ElementType& element, const StretchShearTerms& terms,
+                         const PassType& pass) {
+  for (int a = 0; a < 3; ++a) pass.f[element.vertices[a]] += terms.force[a];
+  if (!pass.matrix) return;
+  for (int a = 0; a < 3; ++a) {
+    (*pass.stiffnessTimesVelocity)[element.vertices[a]] += terms.stiffnessTimesVelocity[a];
+    for (int b = 0; b < 3; ++b) {
+      if (Mat3* block = pass.blockAt(element.slots[3 * a + b])) {
+        addStretchShearBlock(terms, element.membrane, a, b, *block);
+      }
+    }
+  }
+}
+
 }  // namespace
 
 Real ClothForces::evaluate(const Pass& pass) const {
@@ -329,31 +362,96 @@ Real ClothForces::evaluate(const Pass& pass) const {
   // and bending Hessians, by far the costliest part of a kernel, are computed only in Exact mode.
   const bool curvatureOfNonConvex = jacobians && mode == StiffnessMode::Exact;
   const Vec3Array& x = pass.x;
+  const Vec3Array& probe = jacobians ? *pass.velocityForProduct : pass.v;  // u of (∂f/∂x)·u
   const std::vector<Real>& vertexAreas = m_model->vertexAreas();
   TaskSystem& tasks = m_tasks ? *m_tasks : *m_serialTasks;
   const auto sum = [](Real a, Real b) { return a + b; };
+  Real energy = 0;
 
-  // Per-vertex terms: gravity, linear air drag and external forces; the mass matrix and drag on the diagonal.
-  Real energy = tasks.parallelReduce(
-      Index(m_masses.size()), kGrainVertices, Real(0),
+  // Isometric bending's stencils: E = D/2 Σ_s c_s |r_s|² with r_s = S_s x − α_s n_s, damping k_d on
+  // S_s v alike. Each stencil stores c_s (D r_s + k_d S_s v), gathered per vertex below.
+  const Real bendingStiffness = material.bendingStiffness;
+  if (m_isometricBending) {
+    const Real damping = material.bendingDamping;
+    const std::vector<BendingStencil>& stencils = m_model->bendingStencils();
+    const std::span<const StencilWeight> weights = m_model->bendingWeights();
+    const std::span<const Index> ringTriangles = m_model->bendingTriangles();
+    const std::vector<Index>& indices = m_model->indices();
+    energy += tasks.parallelReduce(
+        Index(stencils.size()), kGrainElements, Real(0),
+        [&](Index begin, Index end) {
+          Real blockEnergy = 0;
+          for (Index s = begin; s < end; ++s) {
+            const BendingStencil& stencil = stencils[s];
+            // S_s x and S_s v in one sweep over the weights.
+            Vec3 residual = Vec3::Zero(), rate = Vec3::Zero();
+            for (Index k = stencil.firstWeight, last = k + stencil.weightCount; k < last; ++k) {
+              residual += weights[k].weight * x[weights[k].vertex];
+              rate += weights[k].weight * pass.v[weights[k].vertex];
+            }
+            if (stencil.restCurvature != 0) {
+              residual -= stencil.restCurvature * stencilNormal(stencil, ringTriangles, indices, x);
+            }
+            blockEnergy += Real(0.5) * bendingStiffness * stencil.energyWeight * residual.squaredNorm();
+            m_stencilResiduals[s] =
+                stencil.energyWeight * (bendingStiffness * residual + damping * rate);
+          }
+          return blockEnergy;
+        },
+        sum);
+  }
+
+  // Per vertex: gravity, linear air drag, external forces and the bending force gathered over the
+  // stencils that hold the vertex; in a Jacobian pass the vertex's row is started: its blocks
+  // zeroed, M + h·drag on the diagonal, and bending's −h ∂f/∂v − h² ∂f/∂x = (h k_d + h² D) K̂ ⊗ I₃
+  // with its share of (∂f/∂x)·u = −D K̂ u. One writer per row, entries in column order.
+  const Real bendingScale = pass.h * material.bendingDamping + pass.h * pass.h * bendingStiffness;
+  energy += tasks.parallelReduce(
+      Index(m_masses.size()), kGrainMatrixRows, Real(0),
       [&](Index begin, Index end) {
         Real blockEnergy = 0;
         for (Index i = begin; i < end; ++i) {
           const Real dragCoefficient = material.airDrag * vertexAreas[i];  // N·s/m
-          pass.f[i] =
+          Vec3 force =
               m_masses[i] * m_settings.gravity - dragCoefficient * (pass.v[i] - m_settings.wind);
           blockEnergy -= m_masses[i] * m_settings.gravity.dot(x[i]);
           if (!m_externalForces.empty()) {
             // A constant force is the gradient of the potential −f·x.
-            pass.f[i] += m_externalForces[i];
+            force += m_externalForces[i];
             blockEnergy -= m_externalForces[i].dot(x[i]);
           }
-          if (jacobians) {
-            if (Mat3* block = pass.blockAt(m_diagonalSlots[i])) {
-              *block = (m_masses[i] + pass.h * dragCoefficient) * Mat3::Identity();
+          if (m_isometricBending) {
+            for (Index k = m_stencilUseOffsets[i]; k < m_stencilUseOffsets[i + 1]; ++k) {
+              force -= m_stencilUses[k].weight * m_stencilResiduals[m_stencilUses[k].stencil];
             }
-            (*pass.stiffnessTimesVelocity)[i].setZero();
           }
+          pass.f[i] = force;
+          if (!jacobians) continue;
+          // Every block of the row written once: bending's (h k_d + h² D) K̂_ij I, or zero.
+          for (Index slot = m_rowSlots[i][0]; slot < m_rowSlots[i][1]; ++slot) {
+            const Real diagonal = m_isometricBending ? bendingScale * m_slotBending[slot] : Real(0);
+            Real* block = pass.matrix->block(slot).data();
+            block[0] = diagonal, block[1] = 0, block[2] = 0;
+            block[3] = 0, block[4] = diagonal, block[5] = 0;
+            block[6] = 0, block[7] = 0, block[8] = diagonal;
+          }
+          if (Mat3* block = pass.blockAt(m_diagonalSlots[i])) {
+            block->diagonal().array() += m_masses[i] + pass.h * dragCoefficient;
+          }
+          Vec3 product = Vec3::Zero();
+          if (m_isometricBending) {
+            for (Index k = m_bendingRowOffsets[i]; k < m_bendingRowOffsets[i + 1]; ++k) {
+              const BendingEntry& entry = m_bendingEntries[k];
+              // Blocks towards removed vertices live in the coupling, zeroed by assemble().
+              if (entry.slot >= m_couplingBase) {
+                if (Mat3* block = pass.blockAt(entry.slot)) {
+                  block->diagonal().array() += bendingScale * entry.value;
+                }
+              }
+              product += entry.value * probe[entry.column];
+            }
+          }
+          (*pass.stiffnessTimesVelocity)[i] = -(bendingStiffness * product);
         }
         return blockEnergy;
       },
@@ -373,34 +471,58 @@ Real ClothForces::evaluate(const Pass& pass) const {
     }
   };
 
-  const std::vector<TriangleRest>& triangles = m_model->triangles();
-  forEachColour(m_triangleColours, [&](Index begin, Index end) {
-    Real blockEnergy = 0;
-    ElementForces<3> triangleForces;
-    for (Index t = begin; t < end; ++t) {
-      const Element<3>& element = m_triangles[t];
-      const TriangleRest& rest = triangles[element.modelIndex];
-      const Vec3& x0 = x[element.vertices[0]];
-      const Vec3& x1 = x[element.vertices[1]];
-      const Vec3& x2 = x[element.vertices[2]];
-      const auto velocities = gatherVelocities<3>(element.vertices, pass.v);
-      triangleForces.setZero();
-      const StretchConditions stretch = stretchConditions(
-          x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
-      accumulateConditionForces(stretch.warp, material.warpStretchStiffness,
-                                material.stretchDamping, velocities, mode, jacobians,
-                                triangleForces);
-      accumulateConditionForces(stretch.weft, material.weftStretchStiffness,
-                                material.stretchDamping, velocities, mode, jacobians,
-                                triangleForces);
-      accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
-                                material.shearStiffness, material.shearDamping, velocities, mode,
-                                jacobians, triangleForces);
-      blockEnergy += triangleForces.energy;
-      scatter<3>(element, triangleForces, pass);
-    }
-    return blockEnergy;
-  });
+  // Linear or biphasic stretch (forces/StretchLaw.h).
+  const StretchLaw warpLaw = warpStretchLaw(material), weftLaw = weftStretchLaw(material);
+  const bool linear = !warpLaw.stiffens() && !weftLaw.stiffens();
+  if (linear && (!jacobians || mode == StiffnessMode::Definite)) {
+    // Stretch and shear fused (stretchShear): forces need no mode, Definite Jacobians are its own.
+    const StretchShearCoefficients coefficients{material.warpStretchStiffness,
+                                                material.weftStretchStiffness,
+                                                material.shearStiffness, material.stretchDamping,
+                                                material.shearDamping};
+    forEachColour(m_triangleColours, [&](Index begin, Index end) {
+      Real blockEnergy = 0;
+      for (Index t = begin; t < end; ++t) {
+        const TriangleElement& element = m_triangles[t];
+        const std::array<Index, 3>& corner = element.vertices;
+        const StretchShearTerms terms = stretchShear(
+            {x[corner[0]], x[corner[1]], x[corner[2]]},
+            {pass.v[corner[0]], pass.v[corner[1]], pass.v[corner[2]]},
+            {probe[corner[0]], probe[corner[1]], probe[corner[2]]}, element.membrane,
+            coefficients, pass.h, jacobians);
+        blockEnergy += terms.energy;
+        scatterStretchShear(element, terms, pass);
+      }
+      return blockEnergy;
+    });
+  } else {
+    const std::vector<TriangleRest>& triangles = m_model->triangles();
+    forEachColour(m_triangleColours, [&](Index begin, Index end) {
+      Real blockEnergy = 0;
+      ElementForces<3> triangleForces;
+      for (Index t = begin; t < end; ++t) {
+        const TriangleElement& element = m_triangles[t];
+        const TriangleRest& rest = triangles[element.modelIndex];
+        const Vec3& x0 = x[element.vertices[0]];
+        const Vec3& x1 = x[element.vertices[1]];
+        const Vec3& x2 = x[element.vertices[2]];
+        const auto velocities = gatherVelocities<3>(element.vertices, pass.v);
+        triangleForces.setZero();
+        const StretchConditions stretch = stretchConditions(
+            x0, x1, x2, rest, material.warpRestScale, material.weftRestScale, jacobians);
+        accumulateStretchForces(stretch.warp, warpLaw, rest.area, material.stretchDamping,
+                                velocities, mode, jacobians, triangleForces);
+        accumulateStretchForces(stretch.weft, weftLaw, rest.area, material.stretchDamping,
+                                velocities, mode, jacobians, triangleForces);
+        accumulateConditionForces(shearCondition(x0, x1, x2, rest, curvatureOfNonConvex),
+                                  material.shearStiffness, material.shearDamping, velocities,
+                                  mode, jacobians, triangleForces);
+        blockEnergy += triangleForces.energy;
+        scatter<3>(element, triangleForces, pass);
+      }
+      return blockEnergy;
+    });
+  }
 
   const std::vector<Hinge>& hinges = m_model->hinges();
   forEachColour(m_hingeColours, [&](Index begin, Index end) {
@@ -420,51 +542,6 @@ Real ClothForces::evaluate(const Pass& pass) const {
     }
     return blockEnergy;
   });
-
-  if (m_isometricBending) {
-    // E = D/2 Σ_s c_s |r_s|² with r_s = S_s x − α_s n_s; damping k_d acts on S_s v alike.
-    const Real stiffness = material.bendingStiffness, damping = material.bendingDamping;
-    const std::vector<BendingStencil>& stencils = m_model->bendingStencils();
-    const std::span<const StencilWeight> weights = m_model->bendingWeights();
-    const std::span<const Index> ringTriangles = m_model->bendingTriangles();
-    const std::vector<Index>& indices = m_model->indices();
-    energy += tasks.parallelReduce(
-        Index(stencils.size()), kGrainElements, Real(0),
-        [&](Index begin, Index end) {
-          Real blockEnergy = 0;
-          for (Index s = begin; s < end; ++s) {
-            const BendingStencil& stencil = stencils[s];
-            const Vec3 residual = bendingResidual(stencil, weights, ringTriangles, indices, x);
-            const Vec3 rate = stencilVector(stencil, weights, pass.v);
-            blockEnergy += Real(0.5) * stiffness * stencil.energyWeight * residual.squaredNorm();
-            m_stencilResiduals[s] = stencil.energyWeight * (stiffness * residual + damping * rate);
-          }
-          return blockEnergy;
-        },
-        sum);
-    // Per vertex: the force gathered over the stencils that hold it, and its matrix row
-    // −h ∂f/∂v − h² ∂f/∂x = (h k_d + h² D) K̂ ⊗ I₃ with its share of (∂f/∂x)·u = −D K̂ u.
-    const Real matrixScale = pass.h * damping + pass.h * pass.h * stiffness;
-    tasks.parallelFor(Index(m_masses.size()), kGrainMatrixRows, [&](Index begin, Index end, int) {
-      for (Index i = begin; i < end; ++i) {
-        Vec3 force = Vec3::Zero();
-        for (Index k = m_stencilUseOffsets[i]; k < m_stencilUseOffsets[i + 1]; ++k) {
-          force -= m_stencilUses[k].weight * m_stencilResiduals[m_stencilUses[k].stencil];
-        }
-        pass.f[i] += force;
-        if (!jacobians) continue;
-        Vec3 product = Vec3::Zero();
-        for (Index k = m_bendingRowOffsets[i]; k < m_bendingRowOffsets[i + 1]; ++k) {
-          const BendingEntry& entry = m_bendingEntries[k];
-          if (Mat3* block = pass.blockAt(entry.slot)) {
-            block->diagonal().array() += matrixScale * entry.value;
-          }
-          product += entry.value * (*pass.velocityForProduct)[entry.column];
-        }
-        (*pass.stiffnessTimesVelocity)[i] -= stiffness * product;
-      }
-    });
-  }
 
   forEachColour(m_springColours, [&](Index begin, Index end) {
     Real blockEnergy = 0;
@@ -495,8 +572,8 @@ Real ClothForces::assemble(const Vec3Array& x, const Vec3Array& v, Real h, Block
                            Vec3Array& stiffnessTimesVelocity, PinnedCoupling* coupling) const {
   f.resize(m_masses.size());
   stiffnessTimesVelocity.resize(m_masses.size());
-  // Off-diagonal blocks accumulate; diagonal blocks are overwritten with M + h·drag first.
-  matrix.setZero();
+  // The per-vertex pass starts every matrix row (evaluate); the coupling blocks, written by the
+  // rows next to removed vertices, start from zero here.
   if (coupling) coupling->setZero();
   return evaluate(Pass{x, v, f, h, &matrix, &velocityForProduct, &stiffnessTimesVelocity,
                        m_damping, coupling, m_couplingBase});

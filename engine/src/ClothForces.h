@@ -2,27 +2,35 @@
 // the implicit system.
 //
 // The loop is deliberately trivial: every element (triangle, hinge or spring) asks its pure
-// kernel for conditions (forces/BaraffWitkin.h, forces/SpringCondition.h), turns them into
-// ElementForces (forces/Condition.h), and scatters the result through slots precomputed at set-up
-// into the block-sparse matrix. There is no search and no allocation in a step.
+// kernel for its contribution and scatters it through slots precomputed at set-up into the
+// block-sparse matrix. There is no search and no allocation in a step.
+// - Triangles use stretchShear() (forces/BaraffWitkin.h) for forces and for assemblies in
+//   StiffnessMode::Definite (the implicit solver's): stretch, shear and their damping fused in
+//   closed form, from constants (√a-scaled weights, rest lengths) stored in the element itself, so
+//   the loop streams through one array. Assemblies in Exact mode (checks, Newton), hinges and
+//   springs go through conditions (forces/Condition.h) and ElementForces.
+// - One pass per vertex starts every row: gravity, drag and external forces; the isometric
+//   bending force gathered from its stencils; and the row's blocks set to M + h·drag on the
+//   diagonal plus bending's constant Hessian, (h k_d + h² D) K̂ ⊗ I₃, K̂ = Σ_s c_s w_s w_sᵀ summed
+//   once at set-up (in stencil order) into one scalar per block. Every other block of the row is
+//   zeroed in the same pass, so the matrix is written row by row once before the elements add to
+//   it, with no separate zeroing sweep; bending needs no colouring (one writer per row).
 //
 // Parallel and deterministic: elements of each kind are coloured once (greedily, in model order)
 // so that no two elements of a colour share a vertex. A colour is then a parallelFor whose
 // elements write disjoint vertices and matrix blocks with no locks or atomics, and every force
 // entry and block receives its contributions in colour order, which does not depend on the thread
 // count. Energies are summed per fixed block and combined in block order (TaskSystem's ordered
-// reduction). So 1, 2 or 8 threads give the same bits.
+// reduction). So 1, 2 or 8 threads give the same bits. In Definite mode the matrix is also
+// symmetric to the bit: a triangle writes block (j, i) as the transpose of the (i, j) it computed,
+// K̂ is symmetric, and blocks (i, j) and (j, i) receive their contributions in the same order.
 // Rejected: per-element buffers gathered per row (about 5 MB of extra traffic per assembly on the
 // curtain, where the whole assembly fits in cache), and per-thread copies of the matrix merged in a
 // fixed order (memory × threads, and a merge as costly as the SpMV). Colouring costs one fork/join
 // per colour: the curtain's triangles take 6 colours, its hinges 9 or so.
-//
-// Isometric bending (forces/IsometricBending.h) needs no colouring: its Hessian is the constant
-// D·K̂ ⊗ I₃ with K̂ = Σ_s c_s w_s w_sᵀ over the stencils, summed once at set-up (in stencil order) into one scalar
-// per matrix block. A step computes each stencil's residual (one writer per stencil), then gathers
-// forces and writes matrix rows per vertex (one writer per row, fixed order): no shared writes.
 #pragma once
 
+#include "forces/BaraffWitkin.h"
 #include "forces/Condition.h"
 #include "solver/BlockSparseMatrix.h"
 #include "solver/FreeVertexMap.h"
@@ -119,6 +127,9 @@ class ClothForces {
     std::array<Index, N * N> slots;  // slot of block (vertices[a], vertices[b]) at a·N + b
     Index modelIndex;                // position in the model's list (rest data)
   };
+  struct TriangleElement : Element<3> {
+    StretchShearRest membrane;  // the stretchShear() constants, next to the indices they go with
+  };
   struct SpringElement : Element<2> {
     Real restLength;
     Real stiffness;  // N/m
@@ -128,12 +139,18 @@ class ClothForces {
   const ClothModel* m_model;
   ClothForceSettings m_settings;
   std::vector<Real> m_masses;
-  std::vector<Element<3>> m_triangles;
+  std::vector<TriangleElement> m_triangles;
   std::vector<Element<4>> m_hinges;
   std::vector<SpringElement> m_springs;
   // Elements are stored sorted by colour; colour k holds [colours[k], colours[k + 1]).
   std::vector<Index> m_triangleColours, m_hingeColours, m_springColours;
   std::vector<Index> m_diagonalSlots;
+  // Per vertex, the matrix slots of its row [rowSlots[i][0], rowSlots[i][1]) (empty for a vertex
+  // without a row): the per-vertex pass initialises them, so the matrix needs no separate zeroing.
+  std::vector<std::array<Index, 2>> m_rowSlots;
+  // Per matrix slot, the entry of K̂ it holds (1/m², zero where bending couples nothing): the
+  // per-vertex pass writes each block once as (h k_d + h² D) K̂_ij I.
+  std::vector<Real> m_slotBending;
   // Slots below this are matrix slots; from it on, PinnedCoupling slots offset by it;
   // kInvalidIndex is a block of a removed vertex's row, which is not assembled.
   Index m_couplingBase = kInvalidIndex;

@@ -168,7 +168,7 @@ std::string validateClothSettings(const ClothModel* model, const ClothSettings& 
     if (!problem.empty()) return "cloth settings: " + problem;
   }
   if (int(solver.integrator) < int(IntegratorKind::ExplicitEuler) ||
-      int(solver.integrator) > int(IntegratorKind::ImplicitEuler)) {
+      int(solver.integrator) > int(IntegratorKind::Bdf2)) {
     return "cloth settings: solver.integrator = " + std::to_string(int(solver.integrator)) +
            " is not an IntegratorKind; use one of the enumerators";
   }

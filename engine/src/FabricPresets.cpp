@@ -20,12 +20,30 @@
 // Thickness is the collision margin (ClothMaterial::thickness), not the caliper thickness of the
 // fabric (KES T ≈ 0.3–1.1 mm); it grows with the fabric's weight [EST]. Friction is the
 // cloth-on-cloth Coulomb coefficient, 0.2 (silk) to 0.35 (wool, linen, denim) [EST].
-// Strain limit (ClothMaterial::strainLimit): where the fabric leaves the low-strain regime its
-// stretch stiffness was fitted in and its straightened yarns make it nearly inextensible. Woven
-// fabrics reach that at a few to ~10 % (Provot 1995 uses 10 %); crimped wool a little later,
-// tightly woven heavy twill and flax earlier. All [EST]: neither source measures it.
+//  [KES-T] Kawabata's tensile test (KES-FB1): a strip stretched to 500 gf/cm (490 N/m); EMT is
+//        its strain at that load, LT = WT / (½ · 490 N/m · EMT) the linearity of the curve (1: a
+//        straight line; woven fabric 0.55–0.75: soft while the crimp straightens, stiff after).
+//        Typical apparel ranges as reported in the textile literature (Kawabata, The
+//        Standardization and Analysis of Hand Evaluation, 1980; Hu & Chan, Textile Res. J. 68,
+//        1998): shirting and lawn EMT 3–6 %, worsted suiting 4–8 %, polyester wovens 2–5 %, silk
+//        habutai and crêpe 4–10 %, denim 2–5 % (warp stiffer), linen 2–4 %.
+//
+// Stretch beyond the low-strain regime (ClothMaterial::stretchKneeStrain and the stiffened
+// stiffnesses): the biphasic law of forces/StretchLaw.h keeps each preset's low-strain slope up to
+// a knee and reproduces its KES tensile test beyond: the tension reaches 490 N/m at EMT, and the
+// curve's linearity is LT (biphasicFromKes below solves for the knee and the stiffened slopes).
+// Strain limit of the stiffening presets: EMT, where the measured range of the tensile test
+// ends. The material carries 490 N/m there, a load no cloth scene applies, so the limiter is a
+// safety net for numerical overshoot, not what holds the cloth.
+// Strain limit of the linear presets (ClothMaterial::strainLimit): where the fabric leaves the
+// low-strain regime its stretch stiffness was fitted in. Woven fabrics reach that at a few to
+// ~10 % (Provot 1995 uses 10 %); crimped wool a little later, tightly woven heavy twill and flax
+// earlier. All [EST]: neither source measures it.
 #include <weft/engine/FabricPresets.h>
 
+#include "forces/StretchLaw.h"
+
+#include <algorithm>
 #include <array>
 #include <cctype>
 #include <string>
@@ -41,6 +59,42 @@ constexpr Real kBendingDampingTime = 5e-9 / 2.3e-6;  // s
 // gf·cm²/cm → N·m and gf/(cm·deg) → N/m per radian (see the note at the top).
 constexpr Real kBendingFromKes = 9.80665e-5;
 constexpr Real kShearFromKes = 0.980665 * 180.0 / 3.14159265358979323846;
+
+// KES-FB1's test load: 500 gf/cm in N/m.
+constexpr Real kKesTestTension = 500 * 9.80665e-3 / 0.01;
+
+// The slope k₁ past 2 ε_k that brings the tension to the test load at emt ≥ 2 ε_k: there
+// T = k₀ emt + (k₁ − k₀)(emt − 3 ε_k / 2) (forces/StretchLaw.h).
+Real stiffenedSlope(Real lowStiffness, Real knee, Real emt) {
+  return lowStiffness + (kKesTestTension - lowStiffness * emt) / (emt - 1.5 * knee);
+}
+
+// The knee of StretchLaw (forces/StretchLaw.h) whose curve from 0 to the extensibility `emt` has
+// the linearity `linearity` (LT) with the warp's low-strain stiffness k₀, the tension reaching
+// the test load at emt: LT(ε_k) falls from 1 (ε_k → 0) as the knee moves up, so bisection finds it.
+Real kneeFromKes(Real lowStiffness, Real emt, Real linearity) {
+  const auto lawLinearity = [&](Real knee) {
+    const StretchLaw law{lowStiffness, knee, stiffenedSlope(lowStiffness, knee, emt)};
+    return stretchResponse(law, emt).energyDensity / (0.5 * kKesTestTension * emt);
+  };
+  Real low = 1e-6 * emt, high = 0.5 * emt;
+  for (int iteration = 0; iteration < 100; ++iteration) {
+    const Real middle = 0.5 * (low + high);
+    (lawLinearity(middle) > linearity ? low : high) = middle;
+  }
+  return 0.5 * (low + high);
+}
+
+// Sets the biphasic stretch of `material` from KES tensile figures: the knee from the warp's EMT
+// and LT, and each direction's stiffened slope so that its tension is 490 N/m at its EMT.
+void setTensileTest(ClothMaterial& material, Real warpEmt, Real weftEmt, Real linearity) {
+  const Real knee = kneeFromKes(material.warpStretchStiffness, warpEmt, linearity);
+  material.stretchKneeStrain = knee;
+  material.warpStiffenedStretchStiffness =
+      stiffenedSlope(material.warpStretchStiffness, knee, warpEmt);
+  material.weftStiffenedStretchStiffness =
+      stiffenedSlope(material.weftStretchStiffness, knee, weftEmt);
+}
 
 // A material from its measured (or estimated) stiffnesses, damped like the curtain.
 ClothMaterial makeFabric(Real arealDensity, Real warpStretch, Real weftStretch, Real shear,
@@ -160,6 +214,32 @@ Result<ClothMaterial> fabricPreset(std::string_view name) {
     valid += known;
   }
   return Error{"fabric preset '" + std::string(name) + "' is unknown; choose one of: " + valid};
+}
+
+Result<ClothMaterial> stiffeningFabricPreset(std::string_view name) {
+  // Tensile figures [KES-T]: EMT of warp and weft and the linearity LT. LT 0.65 for all, the
+  // middle of woven apparel fabrics' 0.55–0.75.
+  struct TensileTest {
+    std::string_view name;
+    Real warpEmt, weftEmt, linearity;
+  };
+  constexpr std::array<TensileTest, kNames.size()> kTests{{
+      {"cotton", 0.05, 0.05, 0.65},     // shirting, EMT 3–6 %
+      {"wool", 0.06, 0.07, 0.65},       // worsted suiting, 4–8 %
+      {"polyester", 0.04, 0.04, 0.65},  // polyester wovens, 2–5 %
+      {"silk", 0.07, 0.07, 0.65},       // habutai and crêpe, 4–10 %
+      {"denim", 0.03, 0.05, 0.65},      // denim, 2–5 %, the warp stiffer
+      {"linen", 0.03, 0.03, 0.65},      // linen, 2–4 %
+  }};
+  Result<ClothMaterial> preset = fabricPreset(name);
+  if (!preset.ok()) return preset;
+  ClothMaterial material = preset.value();
+  for (const TensileTest& test : kTests) {
+    if (!equalsIgnoringCase(name, test.name)) continue;
+    setTensileTest(material, test.warpEmt, test.weftEmt, test.linearity);
+    material.strainLimit = std::max(test.warpEmt, test.weftEmt);
+  }
+  return material;
 }
 
 }  // namespace weft

@@ -422,7 +422,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
       std::string valid;
       for (IntegratorKind k : {IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler,
                                IntegratorKind::Midpoint, IntegratorKind::RungeKutta4,
-                               IntegratorKind::ImplicitEuler}) {
+                               IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2}) {
         valid += (valid.empty() ? "" : ", ") + std::string(integratorName(k));
       }
       reader.fail(child(path, "integrator"), "\"" + name + "\" is unknown; choose one of: " + valid);
@@ -1096,7 +1096,7 @@ struct DocumentBuilder {
 std::optional<IntegratorKind> integratorFromName(std::string_view name) {
   for (IntegratorKind kind : {IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler,
                               IntegratorKind::Midpoint, IntegratorKind::RungeKutta4,
-                              IntegratorKind::ImplicitEuler}) {
+                              IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2}) {
     if (name == integratorName(kind)) return kind;
   }
   return std::nullopt;

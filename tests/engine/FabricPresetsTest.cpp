@@ -14,7 +14,7 @@ namespace {
 using ::testing::HasSubstr;
 
 TEST(FabricPresets, CottonIsTheCurtainMaterial) {
-  // DESIGN.md §4: the curtain's default material is "cotton". Compared field by field, exactly.
+  // docs/curtain-benchmark.md: the curtain's default material is "cotton". Compared field by field, exactly.
   const ClothMaterial cotton = cottonFabric();
   const ClothMaterial defaults{};
   EXPECT_EQ(cotton.arealDensity, 0.15);

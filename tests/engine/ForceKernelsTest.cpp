@@ -876,5 +876,187 @@ TEST(ForceKernels, ACollapsedStretchFibreIsPushedOpenAcrossTheOther) {
   EXPECT_LT(opened.weft.value * opened.weft.value, weft.value * weft.value);
 }
 
+// ---------------------------------------------------------------------------------------------
+// stretchShear: the three membrane conditions fused for the implicit step
+
+/// The reference the fused kernel must reproduce: the warp, weft and shear conditions through
+/// accumulateConditionForces in Definite mode, as one 9×9 element.
+struct MembraneReference {
+  Real energy = 0;
+  Positions<3> force, product;
+  Eigen::Matrix<Real, 9, 9> system;  // −h ∂f/∂v − h² ∂f/∂x
+};
+
+MembraneReference membraneReference(const Positions<3>& x, const Positions<3>& v,
+                                    const Positions<3>& u, const TriangleRest& rest,
+                                    const std::array<Real, 2>& restScales,
+                                    const StretchShearCoefficients& k, Real h) {
+  const Vec3 x0 = x.segment<3>(0), x1 = x.segment<3>(3), x2 = x.segment<3>(6);
+  const StretchConditions stretch =
+      stretchConditions(x0, x1, x2, rest, restScales[0], restScales[1], true);
+  ElementForces<3> forces;
+  const StiffnessMode mode = StiffnessMode::Definite;
+  accumulateConditionForces(stretch.warp, k.warpStiffness, k.stretchDamping, v, mode, true, forces);
+  accumulateConditionForces(stretch.weft, k.weftStiffness, k.stretchDamping, v, mode, true, forces);
+  accumulateConditionForces(shearCondition(x0, x1, x2, rest, true), k.shearStiffness,
+                            k.shearDamping, v, mode, true, forces);
+  return {forces.energy, forces.force, forces.positionJacobian * u,
+          -h * forces.velocityJacobian - h * h * forces.positionJacobian};
+}
+
+/// The fused kernel's outputs in the reference's layout.
+struct MembraneFused {
+  Real energy = 0;
+  Positions<3> force, product;
+  Eigen::Matrix<Real, 9, 9> system;
+};
+
+MembraneFused membraneFused(const Positions<3>& x, const Positions<3>& v, const Positions<3>& u,
+                            const StretchShearRest& rest, const StretchShearCoefficients& k,
+                            Real h, bool withSystem = true) {
+  const auto corners = [](const Positions<3>& p) {
+    return std::array<Vec3, 3>{p.segment<3>(0), p.segment<3>(3), p.segment<3>(6)};
+  };
+  const StretchShearTerms terms = stretchShear(corners(x), corners(v), corners(u), rest, k, h, withSystem);
+  MembraneFused out;
+  out.energy = terms.energy;
+  for (int i = 0; i < 3; ++i) {
+    out.force.segment<3>(3 * i) = terms.force[i];
+    if (!withSystem) continue;
+    out.product.segment<3>(3 * i) = terms.stiffnessTimesVelocity[i];
+    for (int j = 0; j < 3; ++j) {
+      Mat3 block = Mat3::Zero();
+      addStretchShearBlock(terms, rest, i, j, block);
+      out.system.block<3, 3>(3 * i, 3 * j) = block;
+    }
+  }
+  return out;
+}
+
+Positions<3> randomVelocities(Random& random, Real amplitude) {
+  Positions<3> v;
+  for (int i = 0; i < 9; ++i) v[i] = random.uniform(-amplitude, amplitude);
+  return v;
+}
+
+TEST(StretchShear, MatchesTheConditionsInDefiniteMode) {
+  // Random stretched, compressed and sheared triangles at two scales, with damping, rest scales
+  // other than 1 and a product vector u other than v: the closed form agrees with the sum of the
+  // three conditions to rounding.
+  Random random(41);
+  const StretchShearCoefficients k{260, 180, 100, 0.5, 0.2};
+  const std::array<Real, 2> restScales{0.97, 1.02};
+  const Real h = 1.0 / 60;
+  int stretchedWarp = 0, compressedWarp = 0;
+  for (Real size : {1.0, 0.05}) {
+    for (int trial = 0; trial < 40; ++trial) {
+      const TriangleSetup setup = randomTriangle(random, size);
+      const Positions<3> v = randomVelocities(random, 1), u = randomVelocities(random, 1);
+      const MembraneReference reference =
+          membraneReference(setup.positions, v, u, setup.rest, restScales, k, h);
+      const StretchShearRest rest = makeStretchShearRest(setup.rest, restScales[0], restScales[1]);
+      const MembraneFused fused = membraneFused(setup.positions, v, u, rest, k, h);
+      const std::string name = "size " + std::to_string(size) + " trial " + std::to_string(trial);
+      EXPECT_NEAR(fused.energy, reference.energy, 1e-12 * reference.energy) << name;
+      EXPECT_LT(relativeError(fused.force, reference.force), 1e-12) << name;
+      EXPECT_LT(relativeError(fused.product, reference.product), 1e-12) << name;
+      EXPECT_LT(relativeError(fused.system, reference.system), 1e-12) << name;
+      // Forces alone are the same bits as with the system.
+      EXPECT_EQ(membraneFused(setup.positions, v, u, rest, k, h, false).force, fused.force) << name;
+      const Real warpLength = (setup.rest.warpWeights[0] * setup.positions.segment<3>(0) +
+                               setup.rest.warpWeights[1] * setup.positions.segment<3>(3) +
+                               setup.rest.warpWeights[2] * setup.positions.segment<3>(6)).norm();
+      (warpLength > restScales[0] ? stretchedWarp : compressedWarp) += 1;
+    }
+  }
+  // Both branches of the geometric stiffness were exercised.
+  EXPECT_GT(stretchedWarp, 10);
+  EXPECT_GT(compressedWarp, 10);
+}
+
+TEST(StretchShear, DerivativesMatchFiniteDifferences) {
+  // Where Definite is exact (both fibres stretched, warp ⟂ weft so the shear condition is zero,
+  // v = 0 so no damping term depends on x): −h ∂f/∂v − h² ∂f/∂x and (∂f/∂x)·u from central
+  // differences of the force, and the force from those of the energy.
+  Random random(43);
+  const StretchShearCoefficients k{260, 180, 100, 0.5, 0.2};
+  const Real h = 1.0 / 60;
+  for (Real size : {1.0, 0.05}) {
+    for (int trial = 0; trial < 10; ++trial) {
+      const std::array<Vec2, 3> uv = randomMaterialTriangle(random, size);
+      const TriangleSetup setup =
+          placeTriangle(uv, planarDeformation(1 + random.uniform(0.05, 0.3), 0, 0,
+                                              1 + random.uniform(0.05, 0.3)),
+                        random.rotation(), random.vector(2), random, 0, size);
+      const StretchShearRest rest = makeStretchShearRest(setup.rest, 1, 1);
+      const Positions<3> zero = Positions<3>::Zero(), u = randomVelocities(random, 1);
+      const Real step = kRelativeStep * size;
+      const std::function<Real(const Positions<3>&)> energy = [&](const Positions<3>& x) {
+        return membraneFused(x, zero, zero, rest, k, h, false).energy;
+      };
+      const std::function<Positions<3>(const Positions<3>&)> forceOfX =
+          [&](const Positions<3>& x) { return membraneFused(x, zero, zero, rest, k, h, false).force; };
+      const std::function<Positions<3>(const Positions<3>&)> forceOfV =
+          [&](const Positions<3>& v) {
+            return membraneFused(setup.positions, v, zero, rest, k, h, false).force;
+          };
+      const MembraneFused fused = membraneFused(setup.positions, zero, u, rest, k, h);
+      const auto positionJacobian = finiteDifferenceJacobian<3>(forceOfX, setup.positions, step);
+      const auto velocityJacobian = finiteDifferenceJacobian<3>(forceOfV, zero, 1e-6);
+      const std::string name = "size " + std::to_string(size) + " trial " + std::to_string(trial);
+      EXPECT_LT(relativeError(fused.force,
+                              -finiteDifferenceGradient<3>(energy, setup.positions, step)),
+                kTolerance) << name;
+      EXPECT_LT(relativeError(fused.system, -h * velocityJacobian - h * h * positionJacobian),
+                kTolerance) << name;
+      EXPECT_LT(relativeError(fused.product, positionJacobian * u), kTolerance) << name;
+    }
+  }
+}
+
+TEST(StretchShear, SystemBlocksAreSymmetricToTheBit) {
+  // The assembled matrix must be symmetric to the bit: block (j, i) is block (i, j) transposed,
+  // and X_vu is X_uv transposed.
+  Random random(47);
+  const StretchShearCoefficients k{260, 260, 100, 0.5, 0.2};
+  for (int trial = 0; trial < 20; ++trial) {
+    const TriangleSetup setup = randomTriangle(random, 0.05);
+    const StretchShearRest rest = makeStretchShearRest(setup.rest, 1, 1);
+    const Positions<3> v = randomVelocities(random, 1);
+    const MembraneFused fused = membraneFused(setup.positions, v, v, rest, k, 1.0 / 60);
+    EXPECT_EQ(fused.system, fused.system.transpose()) << "trial " << trial;
+    const std::array<Vec3, 3> x{setup.positions.segment<3>(0), setup.positions.segment<3>(3),
+                                setup.positions.segment<3>(6)};
+    const StretchShearTerms terms =
+        stretchShear(x, x, x, rest, k, 1.0 / 60, true);
+    EXPECT_EQ(terms.weftWarp, terms.warpWeft.transpose()) << "trial " << trial;
+  }
+}
+
+TEST(StretchShear, CollapsedFibresMatchTheConditions) {
+  // A triangle on one point, and on a line along either fibre: the fallback directions, and no
+  // curvature term, exactly as the conditions have them.
+  const TriangleRest triangle = makeTriangleRest({0, 1, 2}, Vec2(0, 0), Vec2(0.05, 0), Vec2(0, 0.05));
+  const StretchShearRest rest = makeStretchShearRest(triangle, 1, 1);
+  const StretchShearCoefficients k{260, 180, 100, 0.5, 0.2};
+  const Real h = 1.0 / 60;
+  Random random(53);
+  const Vec3 p(0.3, -0.2, 0.1), along(0, 0, 0.05);
+  const std::array<std::pair<std::string, Positions<3>>, 3> cases{{
+      {"point", (Positions<3>() << p, p, p).finished()},
+      {"weft collapsed", (Positions<3>() << p, p + along, p).finished()},
+      {"warp collapsed", (Positions<3>() << p, p, p + along).finished()},
+  }};
+  for (const auto& [name, x] : cases) {
+    const Positions<3> v = randomVelocities(random, 1), u = randomVelocities(random, 1);
+    const MembraneReference reference = membraneReference(x, v, u, triangle, {1, 1}, k, h);
+    const MembraneFused fused = membraneFused(x, v, u, rest, k, h);
+    EXPECT_NEAR(fused.energy, reference.energy, 1e-12 * reference.energy) << name;
+    EXPECT_LT(relativeError(fused.force, reference.force), 1e-12) << name;
+    EXPECT_LT(relativeError(fused.product, reference.product), 1e-12) << name;
+    EXPECT_LT(relativeError(fused.system, reference.system), 1e-12) << name;
+  }
+}
+
 }  // namespace
 }  // namespace weft

@@ -1,6 +1,6 @@
-// Integrators against analytic results: the exact discrete solution of backward Euler on a linear
-// oscillator, the stability limits of the explicit methods, and convergence orders on a
-// nonlinear pendulum of stiff springs run through the full cloth path.
+// Integrators against analytic results: the exact discrete solutions of backward Euler and BDF2
+// on a linear oscillator, the stability limits of the explicit methods, and convergence orders
+// on a nonlinear pendulum of stiff springs run through the full cloth path.
 #include "integrators/Integrator.h"
 #include "integrators/LinearOscillator.h"
 
@@ -56,6 +56,82 @@ TEST(ImplicitEuler, MatchesTheExactDiscreteSolutionOfASpring) {
   EXPECT_NEAR(std::abs(std::arg(eigenvalue)), std::atan(omega * h), 1e-9);
 }
 
+TEST(Bdf2, MatchesTheExactDiscreteSolutionOfASpring) {
+  // m = 1 kg, k = 100 N/m, h = 1/60 s. The first step is backward Euler; every later one solves
+  // x₊ = x̂ + βh v₊, v₊ = v̂ − βh ω² x₊ with x̂ = (4xₙ − xₙ₋₁)/3, v̂ = (4vₙ − vₙ₋₁)/3, β = 2/3.
+  const Real mass = 1, stiffness = 100, h = 1.0 / 60.0;
+  const Real omega2 = stiffness / mass;
+  SolverSettings settings;
+  settings.cgTolerance = 1e-14;
+  settings.cgStopping = PcgStopping::RelativeResidual;
+  std::unique_ptr<Integrator> integrator = Integrator::create(IntegratorKind::Bdf2, settings);
+  ASSERT_EQ(integrator->kind(), IntegratorKind::Bdf2);
+  ASSERT_EQ(integrator->order(), 2);
+  LinearOscillator oscillator(mass, stiffness, 0.0);
+  Vec3Array x{Vec3(0.1, 0, 0)}, v{Vec3(0, 0, 0)};
+  Real px = 0.1, pv = 0;  // the exact discrete solution, by hand
+  Real previousX = 0, previousV = 0;
+  for (int step = 0; step < 240; ++step) {
+    IntegratorReport report;
+    integrator->step(oscillator, x, v, step * h, h, report);
+    Real nx, nv;
+    if (step == 0) {
+      nv = (pv - h * omega2 * px) / (1 + h * h * omega2);
+      nx = px + h * nv;
+    } else {
+      const Real beta = 2.0 / 3.0;
+      const Real hatX = (4 * px - previousX) / 3, hatV = (4 * pv - previousV) / 3;
+      nv = (hatV - beta * h * omega2 * hatX) / (1 + beta * beta * h * h * omega2);
+      nx = hatX + beta * h * nv;
+    }
+    previousX = px, previousV = pv;
+    px = nx, pv = nv;
+    ASSERT_NEAR(x[0].x(), px, 1e-10) << "step " << step;
+    ASSERT_NEAR(v[0].x(), pv, 1e-9) << "step " << step;
+  }
+}
+
+TEST(Bdf2, ChangesStepAndRestartsAfterAGapOrAReset) {
+  // A varying step (ratio up to 2) keeps the variable-step BDF2 on the spring's exact solution to
+  // second order, and a step that does not follow on in time starts again with backward Euler:
+  // stepping after a gap equals a fresh integrator's first step from the same state.
+  const Real stiffness = 100;
+  SolverSettings settings;
+  settings.cgTolerance = 1e-14;
+  settings.cgStopping = PcgStopping::RelativeResidual;
+  LinearOscillator oscillator(1, stiffness, 0.0);
+  // The largest error over the times both step sequences reach (every 1/30 s for 1 s): one time
+  // alone can sit where the error's components cancel.
+  const auto largestError = [&](int refinement) {
+    std::unique_ptr<Integrator> integrator = Integrator::create(IntegratorKind::Bdf2, settings);
+    Vec3Array x{Vec3(0.1, 0, 0)}, v{Vec3::Zero()};
+    Real t = 0, largest = 0;
+    for (int step = 0; step < 90 * refinement; ++step) {
+      const Real h = (step % 3 == 0 ? 2.0 : 1.0) / (120.0 * refinement);  // ratios 2 and ½
+      IntegratorReport report;
+      integrator->step(oscillator, x, v, t, h, report);
+      t += h;
+      if ((step + 1) % (3 * refinement) == 0) {
+        largest = std::max(largest, std::abs(x[0].x() - 0.1 * std::cos(std::sqrt(stiffness) * t)));
+      }
+    }
+    return largest;
+  };
+  EXPECT_NEAR(std::log2(largestError(1) / largestError(2)), 2.0, 0.3);
+
+  std::unique_ptr<Integrator> continued = Integrator::create(IntegratorKind::Bdf2, settings);
+  Vec3Array x{Vec3(0.1, 0, 0)}, v{Vec3::Zero()};
+  IntegratorReport report;
+  for (int step = 0; step < 5; ++step) continued->step(oscillator, x, v, step / 60.0, 1 / 60.0, report);
+  Vec3Array freshX = x, freshV = v;
+  continued->step(oscillator, x, v, 1.0, 1 / 60.0, report);  // 0.92 s later than the last step
+  std::unique_ptr<Integrator> fresh = Integrator::create(IntegratorKind::Bdf2, settings);
+  fresh->step(oscillator, freshX, freshV, 1.0, 1 / 60.0, report);
+  // Up to the solve's round-off (the continued integrator starts its PCG from its last Δv).
+  EXPECT_NEAR((x[0] - freshX[0]).norm(), 0, 1e-15);
+  EXPECT_NEAR((v[0] - freshV[0]).norm(), 0, 1e-13);
+}
+
 TEST(StableStepLimit, MatchesKnownStabilityBoundaries) {
   const Real omega = 50;
   // Symplectic Euler on an undamped oscillator: stable exactly for h ω < 2.
@@ -71,6 +147,7 @@ TEST(StableStepLimit, MatchesKnownStabilityBoundaries) {
   EXPECT_NEAR(stableStepLimit(IntegratorKind::ExplicitEuler, omega, dampingRate, 1e-12),
               dampingRate / (omega * omega), 1e-6);
   EXPECT_TRUE(std::isinf(stableStepLimit(IntegratorKind::ImplicitEuler, omega, 0, 0)));
+  EXPECT_TRUE(std::isinf(stableStepLimit(IntegratorKind::Bdf2, omega, 0, 0)));
 }
 
 // A pendulum: one free vertex hanging from two pinned ones by stiff springs (mass-spring model on
@@ -165,12 +242,15 @@ INSTANTIATE_TEST_SUITE_P(
         OrderCase{IntegratorKind::Midpoint, 0, 2.0, {200, 400, 800, 1600}},
         OrderCase{IntegratorKind::RungeKutta4, 0, 4.0, {100, 200, 400, 800}},
         OrderCase{IntegratorKind::ImplicitEuler, 0, 1.0, {800, 1600, 3200, 6400}},
-        OrderCase{IntegratorKind::ImplicitEuler, 2, 1.0, {800, 1600, 3200, 6400}}),
+        OrderCase{IntegratorKind::ImplicitEuler, 2, 1.0, {800, 1600, 3200, 6400}},
+        OrderCase{IntegratorKind::Bdf2, 0, 2.0, {200, 400, 800, 1600}},
+        OrderCase{IntegratorKind::Bdf2, 2, 2.0, {200, 400, 800, 1600}}),
     [](const ::testing::TestParamInfo<OrderCase>& info) {
       return std::string(info.param.integrator == IntegratorKind::ExplicitEuler     ? "ExplicitEuler"
                          : info.param.integrator == IntegratorKind::SymplecticEuler ? "SymplecticEuler"
                          : info.param.integrator == IntegratorKind::Midpoint        ? "Midpoint"
                          : info.param.integrator == IntegratorKind::RungeKutta4     ? "RungeKutta4"
+                         : info.param.integrator == IntegratorKind::Bdf2            ? "Bdf2"
                                                                                     : "ImplicitEuler") +
              (info.param.newtonIterations ? "Newton" : "");
     });

@@ -9,8 +9,13 @@
 namespace weft {
 namespace {
 
-TEST(SaveState, RestoredWorldContinuesBitForBit) {
-  CurtainScene scene = CurtainScene::create().value();
+class SaveStateIntegrator : public ::testing::TestWithParam<IntegratorKind> {};
+
+TEST_P(SaveStateIntegrator, RestoredWorldContinuesBitForBit) {
+  // BDF2 carries its history (the previous state and step) besides the warm start.
+  CurtainSettings settings;
+  settings.solver.integrator = GetParam();
+  CurtainScene scene = CurtainScene::create(settings).value();
   for (int frame = 0; frame < 80; ++frame) scene.stepFrame();  // into the sphere push
   const WorldState saved = scene.world().saveState();
   const std::uint64_t savedHash = scene.world().stateHash();
@@ -31,6 +36,12 @@ TEST(SaveState, RestoredWorldContinuesBitForBit) {
     ASSERT_EQ(scene.world().stateHash(), original[frame]) << "frame " << frame;
   }
 }
+
+INSTANTIATE_TEST_SUITE_P(Implicit, SaveStateIntegrator,
+                         ::testing::Values(IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2),
+                         [](const ::testing::TestParamInfo<IntegratorKind>& info) {
+                           return info.param == IntegratorKind::Bdf2 ? "Bdf2" : "ImplicitEuler";
+                         });
 
 TEST(SaveState, RestoreWithAMissingClothChangesNothing) {
   World world;

@@ -1,4 +1,4 @@
-// Analytic validation (DESIGN.md §6): small cloths run through the public World API and compared
+// Analytic validation: small cloths run through the public World API and compared
 // with closed forms of classical mechanics.
 //
 //   pendulum     small-angle period 2π √(L/g) of a mass on stiff springs (explicit RK4 and

@@ -1,4 +1,4 @@
-// Determinism contract (DESIGN.md §7): the same inputs and binary give bitwise-identical
+// Determinism contract (docs/architecture.md, "Threads and determinism"): the same inputs and binary give bitwise-identical
 // positions and velocities for 1, 2 and 8 threads, every frame, every run.
 //
 // The curtain runs its whole script (600 frames: the settle, the sphere's push and withdrawal,

@@ -241,7 +241,7 @@ TEST_F(RenderTest, BadInputIsReportedNotDrawn) {
   EXPECT_EQ(renderer->settings().camera.verticalFovDegrees, kFov);  // unchanged
 }
 
-// The 41 × 31 curtain of DESIGN.md §4 (2,400 triangles) in drape-like folds at the two resolutions
+// The 41 × 31 benchmark curtain (2,400 triangles) in drape-like folds at the two resolutions
 // the benchmark uses. Writes PNGs for people to look at and prints the measured times; asserts
 // only what the picture must show, never how long it took.
 TEST_F(RenderTest, DrapedCurtainShowsBothSides) {

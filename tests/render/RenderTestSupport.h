@@ -54,7 +54,7 @@ inline GridCloth makeFlatSquare(double side, int verticesPerSide = 11) {
                   [&](double u, double v) { return Vec3((u - 0.5) * side, (v - 0.5) * side, 0.0); });
 }
 
-/// The DESIGN.md §4 curtain (2 m × 1.5 m, x in [−1, 1], y in [0.5, 2]) hanging in folds that
+/// The benchmark curtain (2 m × 1.5 m, x in [−1, 1], y in [0.5, 2]) hanging in folds that
 /// deepen towards the hem and swing back at the bottom. The folds lean sideways (their top-view
 /// section is a sheared sine, x non-monotone near the hem), so seen from the front some flanks
 /// overhang and show the back of the cloth, as real gathered curtains do.

@@ -406,7 +406,7 @@ TEST(SceneFile, OversizedGridsAreRefusedBeforeTheyAreBuilt) {
 TEST(SceneFile, IntegratorNamesRoundTrip) {
   for (IntegratorKind kind : {IntegratorKind::ExplicitEuler, IntegratorKind::SymplecticEuler,
                               IntegratorKind::Midpoint, IntegratorKind::RungeKutta4,
-                              IntegratorKind::ImplicitEuler}) {
+                              IntegratorKind::ImplicitEuler, IntegratorKind::Bdf2}) {
     EXPECT_EQ(integratorFromName(integratorName(kind)), kind);
   }
   EXPECT_FALSE(integratorFromName("Implicit-Euler").has_value());

@@ -1,10 +1,10 @@
-// Stress scene 1: the curtain (DESIGN.md §4) with one implicit step per frame, at frame steps
+// Stress scene 1: the benchmark curtain with one implicit step per frame, at frame steps
 // from 1/600 s to 1/15 s, over its first 2 s (settle, then the sphere pushes in).
 //
 // Each step size must pass the conditions of StressSupport.h. The error against the
 // 1/600 s run (RMS and max vertex distance at every 1/3 s, divided by the cloth's size, as
-// DESIGN.md §6 measures it) is printed and recorded, not asserted: it is what large steps cost,
-// not a pass condition. The 1/600 s run is the reference here; DESIGN.md's h/16 reference of the
+// bench/ErrorTime.cpp measures it) is printed and recorded, not asserted: it is what large steps cost,
+// not a pass condition. The 1/600 s run is the reference here; the h/16 reference of the
 // error-vs-time sweep (bench/ErrorTime.cpp) is too slow for a test.
 #include "stress/StressSupport.h"
 

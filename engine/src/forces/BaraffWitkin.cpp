@@ -203,6 +203,118 @@ Condition<3> shearCondition(const Vec3& x0, const Vec3& x1, const Vec3& x2,
   return condition;
 }
 
+StretchShearRest makeStretchShearRest(const TriangleRest& rest, Real warpRestScale,
+                                      Real weftRestScale) {
+  StretchShearRest out;
+  out.sqrtArea = std::sqrt(rest.area);
+  out.inverseSqrtArea = 1 / out.sqrtArea;
+  for (int i = 1; i < 3; ++i) {
+    out.warpWeights[i] = out.sqrtArea * rest.warpWeights[i];
+    out.weftWeights[i] = out.sqrtArea * rest.weftWeights[i];
+  }
+  // Weights summing to zero, as makeTriangleRest's: the kernel works on edges from x0.
+  out.warpWeights[0] = -(out.warpWeights[1] + out.warpWeights[2]);
+  out.weftWeights[0] = -(out.weftWeights[1] + out.weftWeights[2]);
+  out.warpRestLength = out.sqrtArea * warpRestScale;
+  out.weftRestLength = out.sqrtArea * weftRestScale;
+  return out;
+}
+
+StretchShearTerms stretchShear(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& v,
+                               const std::array<Vec3, 3>& u, const StretchShearRest& rest,
+                               const StretchShearCoefficients& k, Real h, bool withSystem) {
+  const std::array<Real, 3>& a = rest.warpWeights;
+  const std::array<Real, 3>& b = rest.weftWeights;
+  // The weights sum to zero, so W = Σ a_i x_i = a_1 (x_1 − x_0) + a_2 (x_2 − x_0): a rigid
+  // translation changes nothing, to the bit.
+  const Vec3 edge1 = x[1] - x[0], edge2 = x[2] - x[0];
+  const Vec3 warp = a[1] * edge1 + a[2] * edge2;  // W_u = √a w_u, m
+  const Vec3 weft = b[1] * edge1 + b[2] * edge2;
+  const Vec3 rate1 = v[1] - v[0], rate2 = v[2] - v[0];
+  const Vec3 warpRate = a[1] * rate1 + a[2] * rate2;  // Ẇ_u
+  const Vec3 weftRate = b[1] * rate1 + b[2] * rate2;
+  const Real warpLength = warp.norm(), weftLength = weft.norm();
+
+  // Fibre directions; a collapsed fibre (|w| ≤ kMinStretchRatio) gets the direction
+  // stretchConditions gives it, and no curvature term.
+  const Real minLength = kMinStretchRatio * rest.sqrtArea;
+  const bool warpCollapsed = !(warpLength > minLength);
+  const bool weftCollapsed = !(weftLength > minLength);
+  Vec3 warpDirection = warpCollapsed ? Vec3::UnitX() : Vec3((1 / warpLength) * warp);
+  Vec3 weftDirection = weftCollapsed ? Vec3::UnitY() : Vec3((1 / weftLength) * weft);
+  if (warpCollapsed && !weftCollapsed) warpDirection = acrossDirection(weftDirection);
+  if (weftCollapsed) weftDirection = acrossDirection(warpDirection);
+
+  // Conditions and their rates: C_u = |W_u| − √a b_u, Ċ_u = d_u · Ẇ_u; shear C_s = W_u·W_v/√a with
+  // corner gradients g_i = a_i w_v + b_i w_u, so Ċ_s = w_v·Ẇ_u + w_u·Ẇ_v.
+  const Vec3 warpGradient = rest.inverseSqrtArea * warp;  // w_u
+  const Vec3 weftGradient = rest.inverseSqrtArea * weft;  // w_v
+  const Real warpValue = warpLength - rest.warpRestLength;
+  const Real weftValue = weftLength - rest.weftRestLength;
+  const Real shearValue = warp.dot(weftGradient);
+  const Real warpSpeed = warpDirection.dot(warpRate);
+  const Real weftSpeed = weftDirection.dot(weftRate);
+  const Real shearSpeed = weftGradient.dot(warpRate) + warpGradient.dot(weftRate);
+
+  StretchShearTerms terms;
+  terms.energy = Real(0.5) * (k.warpStiffness * warpValue * warpValue +
+                              k.weftStiffness * weftValue * weftValue +
+                              k.shearStiffness * shearValue * shearValue);
+  // f_i = −(k C + k_d Ċ) ∇_i C summed: −(a_i F_u + b_i F_v).
+  const Real warpScale = k.warpStiffness * warpValue + k.stretchDamping * warpSpeed;
+  const Real weftScale = k.weftStiffness * weftValue + k.stretchDamping * weftSpeed;
+  const Real shearScale = k.shearStiffness * shearValue + k.shearDamping * shearSpeed;
+  const Vec3 warpForce = warpScale * warpDirection + shearScale * weftGradient;
+  const Vec3 weftForce = weftScale * weftDirection + shearScale * warpGradient;
+  for (int i = 0; i < 3; ++i) terms.force[i] = -(a[i] * warpForce + b[i] * weftForce);
+  if (!withSystem) return terms;
+
+  // Definite stiffness of a stretch condition: k d dᵀ + κ (I − d dᵀ), κ = k C/|W| while stretched.
+  const Real warpCurvature =
+      !warpCollapsed && warpValue > 0 ? k.warpStiffness * warpValue / warpLength : Real(0);
+  const Real weftCurvature =
+      !weftCollapsed && weftValue > 0 ? k.weftStiffness * weftValue / weftLength : Real(0);
+
+  // (∂f/∂x)·u = −(a_i P_u + b_i P_v), from U_u = Σ a_j u_j, U_v = Σ b_j u_j.
+  const Vec3 probe1 = u[1] - u[0], probe2 = u[2] - u[0];
+  const Vec3 warpProbe = a[1] * probe1 + a[2] * probe2;
+  const Vec3 weftProbe = b[1] * probe1 + b[2] * probe2;
+  const Real shearProbe =
+      k.shearStiffness * (weftGradient.dot(warpProbe) + warpGradient.dot(weftProbe));
+  const Vec3 warpProduct =
+      warpCurvature * warpProbe +
+      ((k.warpStiffness - warpCurvature) * warpDirection.dot(warpProbe)) * warpDirection +
+      shearProbe * weftGradient;
+  const Vec3 weftProduct =
+      weftCurvature * weftProbe +
+      ((k.weftStiffness - weftCurvature) * weftDirection.dot(weftProbe)) * weftDirection +
+      shearProbe * warpGradient;
+  for (int i = 0; i < 3; ++i) {
+    terms.stiffnessTimesVelocity[i] = -(a[i] * warpProduct + b[i] * weftProduct);
+  }
+
+  // X_uu, X_vv, X_uv and its transpose (header), element by element: each product of two vector
+  // entries is formed before it is scaled, so X_uu and X_vv are symmetric and X_vu is X_uvᵀ, to
+  // the bit.
+  const Real h2 = h * h;
+  const Real shearCoefficient = h2 * k.shearStiffness + h * k.shearDamping;
+  const Real warpAlong = h2 * (k.warpStiffness - warpCurvature) + h * k.stretchDamping;
+  const Real weftAlong = h2 * (k.weftStiffness - weftCurvature) + h * k.stretchDamping;
+  for (int column = 0; column < 3; ++column) {
+    for (int row = 0; row < 3; ++row) {
+      terms.warpWarp(row, column) = warpAlong * (warpDirection[row] * warpDirection[column]) +
+                                    shearCoefficient * (weftGradient[row] * weftGradient[column]);
+      terms.weftWeft(row, column) = weftAlong * (weftDirection[row] * weftDirection[column]) +
+                                    shearCoefficient * (warpGradient[row] * warpGradient[column]);
+      terms.warpWeft(row, column) = shearCoefficient * (weftGradient[row] * warpGradient[column]);
+      terms.weftWarp(row, column) = shearCoefficient * (warpGradient[row] * weftGradient[column]);
+    }
+    terms.warpWarp(column, column) += h2 * warpCurvature;
+    terms.weftWeft(column, column) += h2 * weftCurvature;
+  }
+  return terms;
+}
+
 Real dihedralAngle(const Vec3& x0, const Vec3& x1, const Vec3& x2, const Vec3& x3) {
   const Vec3 edge = x1 - x0;
   const Vec3 normalA = edge.cross(x2 - x0);

@@ -12,6 +12,17 @@
 // BW98 scale by the rest area a; we scale by √a so that E = k/2 C² = k a/2 (|w| − b)²: an energy
 // density times area, with k in N/m whatever the mesh resolution.
 //
+// The implicit step takes the three fused (stretchShear). With the √a-scaled weights a_i, b_i,
+// W_u = Σ a_i x_i = √a w_u and d_u = W_u/|W_u|, the corner gradients are a_i d_u, b_i d_v and
+// g_i = a_i w_v + b_i w_u, so every per-corner quantity is a_i X_a + b_i X_b of two triangle
+// vectors, and the Jacobian block of corners (i, j) is
+//
+//     a_i a_j X_uu + b_i b_j X_vv + a_i b_j X_uv + b_i a_j X_uvᵀ
+//
+// with X_uu = h²κ_u I + (h²(k_u − κ_u) + h k_d) d_u d_uᵀ + (h² k_s + h k_ds) w_v w_vᵀ (κ_u = k_u C_u/|W_u|
+// while stretched, else 0), X_vv alike and X_uv = (h² k_s + h k_ds) w_v w_uᵀ: three 3×3 matrices
+// per triangle instead of three 9×9 Hessians, damping folded into the same blocks.
+//
 // Bending (hinge x0, x1, x2, x3, drawn as in ClothModel.h):
 //
 //            x2                 n_A = (x1 − x0) × (x2 − x0)   normal of A = (x0, x1, x2)
@@ -71,6 +82,74 @@ StretchConditions stretchConditions(const Vec3& x0, const Vec3& x1, const Vec3& 
 /// orthogonal. Not convex. Hessian filled when `withHessian`.
 Condition<3> shearCondition(const Vec3& x0, const Vec3& x1, const Vec3& x2,
                             const TriangleRest& rest, bool withHessian);
+
+/// Rest constants of one triangle's stretch and shear for stretchShear(), precomputed once.
+/// The weights carry √a, so W_u = Σ warpWeights[i] x_i = √a w_u is a length.
+struct StretchShearRest {
+  std::array<Real, 3> warpWeights{};  ///< dimensionless, √a · TriangleRest::warpWeights
+  std::array<Real, 3> weftWeights{};  ///< dimensionless, √a · TriangleRest::weftWeights
+  Real sqrtArea = 0;                  ///< m, √a
+  Real inverseSqrtArea = 0;           ///< 1/m, 1/√a
+  Real warpRestLength = 0;            ///< m, √a · b_u: C_warp = |W_u| − warpRestLength
+  Real weftRestLength = 0;            ///< m, √a · b_v
+};
+
+/// The constants of `rest` for warp and weft rest scales b_u, b_v (see stretchConditions).
+StretchShearRest makeStretchShearRest(const TriangleRest& rest, Real warpRestScale,
+                                      Real weftRestScale);
+
+/// Stiffness and damping of the three membrane conditions (ClothMaterial's fields).
+struct StretchShearCoefficients {
+  Real warpStiffness = 0;   ///< N/m
+  Real weftStiffness = 0;   ///< N/m
+  Real shearStiffness = 0;  ///< N/m
+  Real stretchDamping = 0;  ///< N·s/m, on both stretch conditions
+  Real shearDamping = 0;    ///< N·s/m
+};
+
+/// What one triangle adds to the implicit step (the sum of its warp, weft and shear conditions
+/// through accumulateConditionForces in StiffnessMode::Definite, in closed form).
+struct StretchShearTerms {
+  Real energy = 0;                                  ///< J, elastic k/2 C² summed
+  std::array<Vec3, 3> force;                        ///< N per corner, elastic + damping
+  std::array<Vec3, 3> stiffnessTimesVelocity;       ///< N/s per corner, (∂f/∂x)·u
+  /// kg, X_uu, X_vv, X_uv and X_vu = X_uvᵀ (header): stretchShearBlock() forms the system
+  /// blocks −h ∂f/∂v − h² ∂f/∂x from them. X_uu and X_vv are symmetric to the bit.
+  Mat3 warpWarp, weftWeft, warpWeft, weftWarp;
+};
+
+/// Stretch and shear of triangle x with velocities v: energy and forces always; with
+/// `withSystem`, also (∂f/∂x)·u and the system matrices for step h (s). The Jacobians are those
+/// of StiffnessMode::Definite (Condition.h): the stretch conditions' curvature only while
+/// stretched, the shear's never, damping exact in ∂f/∂v. Collapsed fibres as in stretchConditions.
+StretchShearTerms stretchShear(const std::array<Vec3, 3>& x, const std::array<Vec3, 3>& v,
+                               const std::array<Vec3, 3>& u, const StretchShearRest& rest,
+                               const StretchShearCoefficients& coefficients, Real h,
+                               bool withSystem);
+
+/// Adds the triangle's block of corners (i, j) of −h ∂f/∂v − h² ∂f/∂x (kg) to `block`:
+/// a_i a_j X_uu + b_i b_j X_vv + (a_i b_j X_uv + b_i a_j X_vu). Block (j, i) comes out as the
+/// transpose of block (i, j) to the bit (the bracket sums the same two products), and block (i, i)
+/// symmetric, so a matrix assembled from them is symmetric to the bit.
+inline void addStretchShearBlock(const StretchShearTerms& terms, const StretchShearRest& rest,
+                                 int i, int j, Mat3& block) {
+  const Real uu = rest.warpWeights[i] * rest.warpWeights[j];
+  const Real vv = rest.weftWeights[i] * rest.weftWeights[j];
+  const Real uv = rest.warpWeights[i] * rest.weftWeights[j];
+  const Real vu = rest.weftWeights[i] * rest.warpWeights[j];
+  const Real* warpWarp = terms.warpWarp.data();
+  const Real* weftWeft = terms.weftWeft.data();
+  const Real* warpWeft = terms.warpWeft.data();
+  const Real* weftWarp = terms.weftWarp.data();
+  // Two loops over the nine entries in storage order, the sum into a local first so the compiler
+  // sees no aliasing: both vectorise, and nothing is read transposed.
+  Real sum[9];
+  for (int e = 0; e < 9; ++e) {
+    sum[e] = uu * warpWarp[e] + vv * weftWeft[e] + (uv * warpWeft[e] + vu * weftWarp[e]);
+  }
+  Real* out = block.data();
+  for (int e = 0; e < 9; ++e) out[e] += sum[e];
+}
 
 /// Signed dihedral angle of the hinge (x0, x1, x2, x3) in (−π, π], rad: 0 when flat, positive
 /// when the cloth folds towards the normal of triangle A = (x0, x1, x2). 0 for degenerate input.

@@ -48,8 +48,8 @@ void ImplicitEuler::rotateCarriedState(const Mat3& rotation) {
 void ImplicitEuler::resizeVertices(Index vertexCount) {
   if (m_deltaV.size() == vertexCount) return;
   for (Vec3Array* array : {&m_deltaV, &m_force, &m_stiffnessTimesVelocity, &m_rightHandSide,
-                           &m_iteratePosition, &m_iterateVelocity, &m_prescribedPosition,
-                           &m_prescribedVelocity}) {
+                           &m_iteratePosition, &m_iterateVelocity, &m_expansionVelocity,
+                           &m_prescribedPosition, &m_prescribedVelocity}) {
     array->assign(vertexCount, Vec3::Zero());
   }
   m_hasWarmStart = false;
@@ -159,7 +159,17 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
 
 void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
                          IntegratorReport& report) {
+  stepWithHistory(system, x, v, t, h, ImplicitStepHistory{}, report);
+}
+
+void ImplicitEuler::stepWithHistory(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t,
+                                    Real h, const ImplicitStepHistory& history,
+                                    IntegratorReport& report) {
   const Index n = system.vertexCount();
+  // The solve's step η = βh (h itself for backward Euler) and the two-step offsets, if any.
+  const Real eta = history.beta * h;
+  const Vec3Array* positionOffset = history.positionOffset;
+  const Vec3Array* velocityOffset = history.velocityOffset;
   resizeVertices(n);
   const FreeVertexMap* systemMap = system.freeVertexMap();
   if (!systemMap && m_identityMap.vertexCount() != n) m_identityMap.build(n, {});
@@ -178,7 +188,9 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   system.applyPrescribedMotion(t + h, m_prescribedPosition, m_prescribedVelocity);
   bool removedPins = false;
   for (Index vertex : system.prescribedVertices()) {
-    const Vec3 target = (m_prescribedPosition[vertex] - x[vertex]) / h - v[vertex];
+    // x_{n+1} = x̂ + η (v_n + Δv) on the target.
+    const Vec3 start = positionOffset ? Vec3(x[vertex] + (*positionOffset)[vertex]) : x[vertex];
+    const Vec3 target = (m_prescribedPosition[vertex] - start) / eta - v[vertex];
     const Index row = map.row(vertex);
     if (row == kInvalidIndex) {
       m_deltaV[vertex] = target;
@@ -191,15 +203,23 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   // Contacts with colliders: one constrained direction each.
   system.constrainContacts(x, v, h, m_filter);
 
-  // Baraff–Witkin step, expanded about (x_n, v_n).
+  // Baraff–Witkin step, expanded about (x_n, v_n); the stiffness acts on u (v_n without history).
+  if (positionOffset) {
+    for (Index i = 0; i < n; ++i) m_expansionVelocity[i] = v[i] + (*positionOffset)[i] / eta;
+  }
+  const Vec3Array& expansionVelocity = positionOffset ? m_expansionVelocity : v;
   {
     WEFT_PROFILE_ZONE("assembly");
     const std::int64_t start = FrameClock::nowNs();
-    report.potentialEnergy = system.linearize(x, v, t, h, m_force, v, m_stiffnessTimesVelocity);
+    report.potentialEnergy =
+        system.linearize(x, v, t, eta, m_force, expansionVelocity, m_stiffnessTimesVelocity);
     report.assemblyMs += FrameClock::msSince(start);
   }
   for (Index i = 0; i < n; ++i) {
-    m_rightHandSide[i] = h * (m_force[i] + h * m_stiffnessTimesVelocity[i]);
+    m_rightHandSide[i] = eta * (m_force[i] + eta * m_stiffnessTimesVelocity[i]);
+  }
+  if (velocityOffset) {
+    for (Index i = 0; i < n; ++i) m_rightHandSide[i] += masses[i] * (*velocityOffset)[i];
   }
   map.gather(m_rightHandSide, m_rowRightHandSide);
   // b_f − A_fp Δv_p: the pull of removed pins on their free neighbours.
@@ -218,15 +238,15 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   // most (a term left pulling only delays a separation by one step, one left out lets a pair
   // approach further in one step; the self-collision pass keeps the contacts either way).
   m_couplingActive.assign(system.contactCouplings().size(), 0);  // keeps its capacity
-  (void)updateActiveCouplings(system, h);
-  gatherCouplings(system, map, removedPins, h, /*newton=*/false);
+  (void)updateActiveCouplings(system, eta);
+  gatherCouplings(system, map, removedPins, eta, /*newton=*/false);
   solve(system, report);
   map.scatter(m_correction, m_deltaV);
   for (int pass = 0; pass < kContactReleasePasses && !system.contactCouplings().empty(); ++pass) {
-    if (!updateActiveCouplings(system, h)) break;
+    if (!updateActiveCouplings(system, eta)) break;
     map.gather(m_rightHandSide, m_rowRightHandSide);
     if (removedPins) system.subtractPrescribedCoupling(m_deltaV, m_rowRightHandSide);
-    gatherCouplings(system, map, removedPins, h, /*newton=*/false);
+    gatherCouplings(system, map, removedPins, eta, /*newton=*/false);
     solve(system, report);
     map.scatter(m_correction, m_deltaV);
   }
@@ -269,23 +289,27 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
   for (int iteration = 0; iteration < m_settings.newtonIterations; ++iteration) {
     for (Index i = 0; i < n; ++i) {
       m_iterateVelocity[i] = v[i] + m_deltaV[i];
-      m_iteratePosition[i] = x[i] + h * m_iterateVelocity[i];
+      m_iteratePosition[i] = x[i] + eta * m_iterateVelocity[i];
+      if (positionOffset) m_iteratePosition[i] += (*positionOffset)[i];
     }
     {
       WEFT_PROFILE_ZONE("assembly");
       const std::int64_t start = FrameClock::nowNs();
-      system.linearize(m_iteratePosition, m_iterateVelocity, t + h, h, m_force, m_iterateVelocity,
-                       m_stiffnessTimesVelocity);
+      system.linearize(m_iteratePosition, m_iterateVelocity, t + h, eta, m_force,
+                       m_iterateVelocity, m_stiffnessTimesVelocity);
       report.assemblyMs += FrameClock::msSince(start);
     }
-    for (Index i = 0; i < n; ++i) m_rightHandSide[i] = h * m_force[i] - masses[i] * m_deltaV[i];
+    for (Index i = 0; i < n; ++i) m_rightHandSide[i] = eta * m_force[i] - masses[i] * m_deltaV[i];
+    if (velocityOffset) {
+      for (Index i = 0; i < n; ++i) m_rightHandSide[i] += masses[i] * (*velocityOffset)[i];
+    }
     map.gather(m_rightHandSide, m_rowRightHandSide);
     // Every contact term again (the active set is not carried across linearisations); the pins'
     // corrections are zero.
     const std::span<const ContactCoupling> terms = system.contactCouplings();
     m_couplingActive.resize(terms.size());
     for (std::size_t index = 0; index < terms.size(); ++index) m_couplingActive[index] = terms[index].force > 0;
-    gatherCouplings(system, map, /*removedPins=*/false, h, /*newton=*/true);
+    gatherCouplings(system, map, /*removedPins=*/false, eta, /*newton=*/true);
     for (Index row = 0; row < rows; ++row) m_correction[row].setZero();
     solve(system, report);
     for (Index row = 0; row < rows; ++row) m_deltaV[map.vertex(row)] += m_correction[row];
@@ -293,7 +317,8 @@ void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real
 
   for (Index i = 0; i < n; ++i) {
     v[i] += m_deltaV[i];
-    x[i] += h * v[i];
+    x[i] += eta * v[i];
+    if (positionOffset) x[i] += (*positionOffset)[i];
   }
   // Exact pin positions (the filter already made them exact up to round-off).
   system.applyPrescribedMotion(t + h, x, v);

@@ -19,6 +19,16 @@
 // terms the system adds to A outside its pattern; the PCG applies them matrix-free, and a removed
 // pin in one contributes its known Δv to the right-hand side. Warm start: the PCG begins from the previous step's Δv, which is close in smooth
 // motion.
+//
+// Two-step methods (Bdf2.h) reuse this step through ImplicitStepHistory: with a step scale β and
+// the history's offsets x̂ = x_n + positionOffset, v̂ = v_n + velocityOffset, the step solves
+//      x_{n+1} = x̂ + βh v_{n+1},      M (v_{n+1} − v̂) = βh f(x_{n+1}, v_{n+1}).
+// With η = βh and u = v_n + (x̂ − x_n)/η, so that x_{n+1} − x_n = η (u + Δv), the same expansion
+// about (x_n, v_n) gives the same matrix with η for h:
+//      (M − η ∂f/∂v − η² ∂f/∂x) Δv = η (f_n + η ∂f/∂x u) + M (v̂ − v_n)
+// and a Newton iteration solves (…)|_k δ = η f(x_k, v_k) − M (Δv_k − (v̂ − v_n)) with
+// x_k = x̂ + η v_k. Backward Euler is β = 1 without offsets (x̂ = x_n, v̂ = v_n, u = v_n): the
+// equations above, and the same bits.
 #pragma once
 
 #include "integrators/Integrator.h"
@@ -29,6 +39,14 @@
 
 namespace weft {
 
+/// The history a two-step implicit method adds to the step (see the note above): backward Euler
+/// when beta = 1 and both offsets are null.
+struct ImplicitStepHistory {
+  Real beta = 1;                              ///< step scale β: the step solves with η = βh
+  const Vec3Array* positionOffset = nullptr;  ///< m by vertex, x̂ − x_n; null = none
+  const Vec3Array* velocityOffset = nullptr;  ///< m/s by vertex, v̂ − v_n; null = none
+};
+
 class ImplicitEuler final : public Integrator {
  public:
   explicit ImplicitEuler(const SolverSettings& settings) : m_settings(settings) {}
@@ -37,6 +55,10 @@ class ImplicitEuler final : public Integrator {
   int order() const override { return 1; }
   void step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
             IntegratorReport& report) override;
+  /// The step of a two-step method whose history is `history` (Bdf2); step() is this with
+  /// ImplicitStepHistory{}.
+  void stepWithHistory(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
+                       const ImplicitStepHistory& history, IntegratorReport& report);
   void reset() override;
   void setSolveLimits(Real tolerance, int maxIterations) override {
     m_settings.cgTolerance = tolerance;
@@ -55,7 +77,8 @@ class ImplicitEuler final : public Integrator {
   void resizeRows(Index rowCount);
   void solve(DynamicSystem& system, IntegratorReport& report);
   // The system's active contact couplings renumbered into rows (m_rowCouplings), their forces
-  // added to the row right-hand side (h (F + h K v), or h F for a Newton iteration) and, with
+  // added to the row right-hand side (h (F + h K v), or h F for a Newton iteration; h is the
+  // step's η) and, with
   // removedPins, their coupling to removed pins' known Δv (m_deltaV) taken to it.
   void gatherCouplings(const DynamicSystem& system, const FreeVertexMap& map, bool removedPins,
                        Real h, bool newton);
@@ -81,6 +104,7 @@ class ImplicitEuler final : public Integrator {
   Vec3Array m_rightHandSide;     // b by vertex
   Vec3Array m_iteratePosition;   // x_k
   Vec3Array m_iterateVelocity;   // v_k
+  Vec3Array m_expansionVelocity;  // u = v_n + (x̂ − x_n)/η of a two-step method's step
   Vec3Array m_prescribedPosition, m_prescribedVelocity;
   std::vector<ContactCoupling> m_rowCouplings;  // the system's active contact couplings, by row
   std::vector<char> m_couplingActive;           // per system coupling: 1 while it pushes

@@ -1,5 +1,6 @@
 #include "integrators/Integrator.h"
 
+#include "integrators/Bdf2.h"
 #include "integrators/ExplicitIntegrators.h"
 #include "integrators/ImplicitEuler.h"
 #include "integrators/LinearOscillator.h"
@@ -18,6 +19,7 @@ const char* integratorName(IntegratorKind kind) {
     case IntegratorKind::Midpoint: return "midpoint";
     case IntegratorKind::RungeKutta4: return "rk4";
     case IntegratorKind::ImplicitEuler: return "implicit-euler";
+    case IntegratorKind::Bdf2: return "bdf2";
   }
   return "unknown";
 }
@@ -29,6 +31,7 @@ std::unique_ptr<Integrator> Integrator::create(IntegratorKind kind, const Solver
     case IntegratorKind::Midpoint: return std::make_unique<Midpoint>();
     case IntegratorKind::RungeKutta4: return std::make_unique<RungeKutta4>();
     case IntegratorKind::ImplicitEuler: return std::make_unique<ImplicitEuler>(settings);
+    case IntegratorKind::Bdf2: return std::make_unique<Bdf2>(settings);
   }
   return nullptr;
 }
@@ -53,7 +56,8 @@ Real amplification(Integrator& integrator, LinearOscillator& oscillator, Real h)
 }  // namespace
 
 Real stableStepLimit(IntegratorKind kind, Real omega, Real dampingRate, Real growthPerStep) {
-  if (kind == IntegratorKind::ImplicitEuler) return std::numeric_limits<Real>::infinity();
+  // Both implicit methods are A-stable: no step makes a damped linear mode grow.
+  if (isImplicit(kind)) return std::numeric_limits<Real>::infinity();
   if (!(omega > 0)) return std::numeric_limits<Real>::infinity();
   std::unique_ptr<Integrator> integrator = Integrator::create(kind, SolverSettings{});
   LinearOscillator oscillator(1.0, omega * omega, dampingRate);

@@ -1,9 +1,9 @@
 // Integrator: advances a DynamicSystem by one step h.
 //
-// Five methods behind one interface (SolverSettings::integrator). The explicit ones only
+// Six methods behind one interface (SolverSettings::integrator). The explicit ones only
 // evaluate forces; ImplicitEuler linearises once per step as in Baraff & Witkin 1998 (eq. 16),
 // optionally followed by Newton iterations on the full backward-Euler equations, and solves with
-// the filtered PCG. Prescribed (pinned) vertices follow DynamicSystem::applyPrescribedMotion()
+// the filtered PCG; Bdf2 takes the same step with a two-step history (Bdf2.h). Prescribed (pinned) vertices follow DynamicSystem::applyPrescribedMotion()
 // at every stage, so every method can run every scene.
 #pragma once
 
@@ -63,7 +63,7 @@ class Integrator {
 
 /// Largest step h (s) at which `kind` keeps a damped linear mode ẍ = −ω² x − c ẋ from growing by
 /// more than a factor (1 + growthPerStep) per step. ω in rad/s, c in 1/s. Infinity for the
-/// implicit method. Found from the method's own amplification matrix (it steps a one-vertex
+/// implicit methods. Found from the method's own amplification matrix (it steps a one-vertex
 /// oscillator through the same code), so it is exact for every method without a formula each.
 Real stableStepLimit(IntegratorKind kind, Real omega, Real dampingRate, Real growthPerStep);
 

@@ -45,6 +45,14 @@ struct ClothMaterial {
   /// Provot 1995; woven fabric is nearly inextensible past ~10 %). Lower feels stiffer and costs
   /// limiter iterations. 0 or infinity = off (default); the fabric presets set it (cotton 0.10).
   Real strainLimit = 0.0;
+  /// Fibre strain at which the yarns have straightened and the stretch stiffness starts to rise
+  /// towards the stiffened values below (reached at twice this strain): woven fabric's biphasic
+  /// tension. 0 or infinity = linear stretch (default); stiffeningFabricPreset() sets it.
+  Real stretchKneeStrain = 0.0;
+  /// N/m, warp stretch stiffness past the knee (stretchKneeStrain); at least warpStretchStiffness.
+  Real warpStiffenedStretchStiffness = 0.0;
+  /// N/m, weft stretch stiffness past the knee (stretchKneeStrain); at least weftStretchStiffness.
+  Real weftStiffenedStretchStiffness = 0.0;
 };
 
 /// The classic mass-spring network (Provot 1995): one stiffness per spring family.
