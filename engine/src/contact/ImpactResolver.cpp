@@ -38,6 +38,11 @@ Index findRoot(std::vector<Index>& parent, Index vertex) {
   return vertex;
 }
 
+// Sweeps over the faces on thin bodies, until no point moves more than round-off (neighbouring
+// faces share corners), a few at most.
+constexpr int kFaceSweeps = 4;
+constexpr Real kSettledDepth = 1e-9;
+
 }  // namespace
 
 void ImpactResolver::build(const ContactSpace& space, TaskSystem* tasks) {
@@ -55,24 +60,6 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
                                          std::span<const ColliderFrame> colliders) {
   m_near.clear();
   if (colliders.empty()) return 0;
-  // The faces, swept until no point moves more than round-off (neighbouring faces share
-  // corners), a few times at most.
-  constexpr int kFaceSweeps = 4;
-  constexpr Real kSettledDepth = 1e-9;
-  for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
-    Real deepest = 0;
-    for (std::size_t c = 0; c < set.firstPair; ++c) {
-      const Contact& contact = set.contacts[c];
-      if (contact.kind != ContactKind::FaceCollider) continue;
-      Vec3 normal;
-      deepest = std::max(deepest, pushFaceOut(set.cores[contact.core], contact.normal,
-                                              colliders[contact.collider].end.pose,
-                                              {contact.vertices[0], contact.vertices[1],
-                                               contact.vertices[2]},
-                                              space.inverseMass, space.x, space.v, 0, normal));
-    }
-    if (!(deepest > kSettledDepth)) break;
-  }
   Real thickness = 0;
   for (const ContactOwner& owner : space.owners) thickness = std::max(thickness, owner.thickness);
   Aabb path = Aabb::empty();
@@ -92,7 +79,7 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
       m_near.push_back(k);
     }
   }
-  if (m_near.empty()) return 0;
+  if (m_near.empty()) return 0;  // and so no face contact either
   WEFT_PROFILE_ZONE("collider impacts");
   Index corrected = 0;
   for (Index i = 0; i < space.vertexCount(); ++i) {
@@ -101,7 +88,8 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
     bool moved = false;
     for (Index k : m_near) {
       const ColliderFrame& collider = colliders[k];
-      const Vec3 outside = keepOutside(collider, space.startX[i], space.x[i], thickness);
+      const Vec3 outside = keepOutsideFrom(collider.shape, traceStart(i, collider, space),
+                                           space.x[i], thickness);
       if (outside == space.x[i]) continue;
       space.x[i] = outside;
       // Inelastic: no relative velocity into the surface.
@@ -111,6 +99,22 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
       moved = true;
     }
     corrected += moved;
+  }
+  // Then the faces on bodies thinner than the triangles, which have the last word: a vertex
+  // pushed out of one capsule of a ring may tilt its face into the next.
+  for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
+    Real deepest = 0;
+    for (std::size_t c = 0; c < set.firstPair; ++c) {
+      const Contact& contact = set.contacts[c];
+      if (contact.kind != ContactKind::FaceCollider) continue;
+      Vec3 normal;
+      deepest = std::max(deepest, pushFaceOut(set.cores[contact.core], contact.normal,
+                                              colliders[contact.collider].end.pose,
+                                              {contact.vertices[0], contact.vertices[1],
+                                               contact.vertices[2]},
+                                              space.inverseMass, space.x, space.v, 0, normal));
+    }
+    if (!(deepest > kSettledDepth)) break;
   }
   return corrected;
 }
@@ -130,6 +134,11 @@ Real ImpactResolver::impulseInverseMass(Index vertex, const ContactSpace& space)
   return m_held[vertex] ? kHeldInverseMassScale * inverseMass : inverseMass;
 }
 
+Vec3 ImpactResolver::traceStart(Index vertex, const ColliderFrame& collider,
+                                const ContactSpace& space) const {
+  return m_tracked[vertex] ? m_projected[vertex] : collider.carry(space.startX[vertex]);
+}
+
 void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
   if (m_near.empty()) return;
   for (Index i = 0; i < space.vertexCount(); ++i) {
@@ -139,9 +148,40 @@ void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
       // The way there, relative to the body, not only the end: an impulse may send a vertex
       // through a thin or fast body.
       const Vec3 end = space.startX[i] + h * m_velocity[i];
-      const Vec3 outside = keepOutside(m_colliders[k], space.startX[i], end, thickness);
+      const Vec3 outside =
+          keepOutsideFrom(m_colliders[k].shape, traceStart(i, m_colliders[k], space), end,
+                          thickness);
       if (outside != end) m_velocity[i] = (outside - space.startX[i]) / h;
     }
+  }
+  // The faces on a body thinner than the triangles, whose corners an impulse moved: a face an
+  // impulse pushed into a core goes back out to its reach, as a velocity change of its corners.
+  if (m_set == nullptr) return;
+  bool endsKnown = false;
+  for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
+    Real deepest = 0;
+    for (std::size_t c = 0; c < m_set->firstPair; ++c) {
+      const Contact& contact = m_set->contacts[c];
+      if (contact.kind != ContactKind::FaceCollider) continue;
+      const std::array<Index, 3> corner{contact.vertices[0], contact.vertices[1],
+                                        contact.vertices[2]};
+      if (!m_touched[corner[0]] && !m_touched[corner[1]] && !m_touched[corner[2]]) continue;
+      if (!endsKnown) {
+        for (Index i = 0; i < space.vertexCount(); ++i) {
+          m_end[i] = space.startX[i] + h * m_velocity[i];
+        }
+        endsKnown = true;
+      }
+      Vec3 normal;
+      const Real depth = pushFaceOut(m_set->cores[contact.core], contact.normal,
+                                     m_colliders[contact.collider].end.pose, corner,
+                                     space.inverseMass, m_end, m_velocity, 1 / h, normal);
+      if (depth > 0) {
+        for (Index i : corner) m_touched[i] = 1;
+      }
+      deepest = std::max(deepest, depth);
+    }
+    if (!(deepest > kSettledDepth)) break;
   }
 }
 
@@ -334,6 +374,17 @@ ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
   WEFT_PROFILE_ZONE("impacts");
   ImpactReport report;
   m_colliders = colliders;
+  m_set = &set;
+  // The projection followed its collider contacts along the way it moved them, so their
+  // positions now are outside and reached legally; the fail-safe traces them from there. A
+  // straight path from the substep's start may cut through a body the projection slid them
+  // round, and putting them back on it would undo the projection's strain limit.
+  m_projected = space.x;
+  m_tracked.assign(space.vertexCount(), 0);
+  for (std::size_t c = 0; c < set.firstPair; ++c) {
+    const Contact& contact = set.contacts[c];
+    if (contact.kind == ContactKind::VertexCollider) m_tracked[contact.vertices[0]] = 1;
+  }
   report.colliderCorrections = keepOutOfColliders(space, set, colliders);
   if (!pairs) return report;
   // The detection's feature pairs were found over x₀ → x₁ with a margin R; this stage's swept

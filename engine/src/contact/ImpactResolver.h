@@ -3,11 +3,15 @@
 //
 // It runs on the substep's start x₀ and the end x₁ the projection left, through the average
 // velocity v̄ = (x₁ − x₀)/h, and changes only what must change:
-//  1. Colliders: the faces of the substep's face contacts are put back at their reach from the
-//     cores (converged, where the projection stopped at its tolerance), then every vertex's path
-//     relative to each body is traced; one that passed through a body or ends within its
-//     thickness is put back outside and keeps no velocity into it (a body too fast or too thin
-//     for the detection's candidates). The vertices keep the last word over the faces.
+//  1. Colliders: every vertex's path relative to each body is traced; one that passed through a
+//     body or ends within its thickness is put back outside and keeps no velocity into it (a
+//     body too fast or too thin for the detection's candidates). A vertex the projection
+//     followed as a collider contact is traced from where the projection left it: the
+//     projection moved it round the body step by step, and the straight path from x₀ may cut
+//     through a body it slid round (putting it back there would undo the strain limit). Then
+//     the faces of the substep's face contacts are put back at their reach from the cores
+//     (converged, where the projection stopped at its tolerance): a vertex pushed out of one
+//     capsule of a ring may tilt its face into the next.
 //  2. Swept tests: the motion x₀ → x₀ + h v̄ of every vertex–triangle and edge–edge pair of the
 //     broad phase is tested for the first time of coplanarity; each hit gets an impulse that
 //     leaves the pair separating. Repeated a bounded number of passes, each testing again only
@@ -18,7 +22,7 @@
 //     the vertices still colliding keep their start positions, which cannot cross since x₀ is free
 //     of crossings. So no crossing survives a substep.
 // After every round of impulses, a corrected vertex whose path now meets a collider is put back
-// out of it; a vertex that ends within 1.5 thicknesses of a collider counts 1000× heavier in the
+// out of it, and a face an impulse moved into a core back to its reach; a vertex that ends within 1.5 thicknesses of a collider counts 1000× heavier in the
 // impulses, so the free side of a pair takes them.
 //
 // Impulses are shared among the four vertices of a pair by barycentric weight and inverse mass.
@@ -89,12 +93,15 @@ class ImpactResolver {
   void rigidifyZones(const ContactSpace& space);
   Real impulseInverseMass(Index vertex, const ContactSpace& space);
   void clampToColliders(const ContactSpace& space, Real h);
+  // Where a vertex's way to its end is traced from against `collider` (body end frame).
+  Vec3 traceStart(Index vertex, const ColliderFrame& collider, const ContactSpace& space) const;
 
   TaskSystem* m_tasks = nullptr;
   bool m_skip = true;
   FeaturePairs m_features;
   const FeaturePairs* m_candidates = nullptr;  // the detection's, for the first swept test
   std::span<const ColliderFrame> m_colliders;
+  const ContactSet* m_set = nullptr;  // this substep's, for its face contacts
   std::vector<Index> m_near;                 // colliders near the cloth this substep
   OrderedPairFilter<Impact> m_pairFilter;
   std::vector<Impact> m_impacts;
@@ -103,6 +110,8 @@ class ImpactResolver {
   Vec3Array m_testedEnd;                     // the ends of the last swept test
   std::vector<char> m_dirty;                 // per vertex: test its pairs again
   std::vector<char> m_touched;               // per vertex: v̄ changed
+  Vec3Array m_projected;                     // x as the projection left it
+  std::vector<char> m_tracked;               // per vertex: in a collider contact of the set
   std::vector<signed char> m_held;           // per vertex: −1 unknown, 0 free, 1 held
   std::vector<Index> m_zoneParent;           // union–find over vertices
   std::vector<char> m_inZone;
