@@ -62,9 +62,14 @@ void ContactDetector::selectNear(const ContactSpace& space,
     const ColliderFrame& collider = colliders[k];
     Aabb box = path;
     if (!collider.still()) {
+      // A turning body: the paths relative to it are arcs, which stray from their chords.
+      Real bulge = 0;
       for (Index i = 0; i < space.vertexCount(); ++i) {
-        if (space.inverseMass[i] != 0) box.expand(collider.carry(space.startX[i]));
+        if (space.inverseMass[i] == 0) continue;
+        box.expand(collider.carry(space.startX[i]));
+        bulge = std::max(bulge, pathBulge(collider, space.startX[i], end[i]));
       }
+      box.inflate(bulge);
     }
     if (!m_skip || mayTouch(collider.shape, box, reach)) {
       m_near.push_back(k);
@@ -105,15 +110,14 @@ void ContactDetector::constrain(const ContactSpace& space,
         // Where the predicted motion relative to the body first meets it gives the face to stop
         // on: the end pose alone would push a vertex a fast body overran out through its far side.
         if (const std::optional<PathContact> hit =
-                firstContact(collider.shape, collider.carry(space.startX[i]), predicted,
-                             thickness)) {
+                firstContactAlong(collider, space.startX[i], predicted, thickness)) {
           // A path that stays outside after it comes near is a graze: the end's own distance
           // holds. Extrapolating the hit's tangent plane would overshoot on a curved body.
           const bool graze =
               contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
               queryPoint(collider.shape, 0.5 * (hit->point + predicted)).distance > 0;
           if (!graze) {
-            direction = hit->normal;
+            direction = hit->impactNormal;
             depth = hit->distance + hit->normal.dot(predicted - hit->point);
           }
         }
@@ -189,7 +193,7 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
       const std::optional<PathContact> hit =
           end.distance < thickness + margin
               ? std::nullopt
-              : firstContact(collider.shape, start, space.x[i], thickness);
+              : firstContactAlong(collider, space.startX[i], space.x[i], thickness);
       if (!(end.distance < thickness + margin) && !hit) continue;
       Contact contact;
       contact.kind = ContactKind::VertexCollider;

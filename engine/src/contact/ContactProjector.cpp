@@ -96,12 +96,6 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   }
   m_friction.assign(count, Vec3::Zero());
   m_lastOutside.resize(count);
-  for (std::size_t c = 0; c < set.firstPair; ++c) {
-    const Contact& contact = set.contacts[c];
-    if (contact.kind == ContactKind::VertexCollider) {
-      m_lastOutside[c] = colliders[contact.collider].carry(space.startX[contact.vertices[0]]);
-    }
-  }
   for (int iteration = 0;; ++iteration) {
     const bool backward = iteration % 2 == 1;
     m_frictionOn = iteration < kFrictionSweeps;
@@ -229,11 +223,13 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   const ShapeContact before = queryPoint(collider.shape, x);
   Real depth = 0;
   // Followed from where it was last outside, the body held at its end pose; on the first visit
-  // from the substep's start carried with the body, so that a vertex a fast or thin body passed
-  // through is found although it ends clear of it.
+  // along its whole path relative to the body over the substep, so that a vertex a fast or thin
+  // body passed through is found although it ends clear of it.
   const bool firstVisit = !m_visited[index];
   if (before.distance < thickness || firstVisit) {
-    const Vec3 outside = keepOutsideFrom(collider.shape, m_lastOutside[index], x, thickness);
+    const Vec3 outside =
+        firstVisit ? keepOutside(collider, space.startX[i], x, thickness)
+                   : keepOutsideFrom(collider.shape, m_lastOutside[index], x, thickness);
     const Vec3 shift = outside - x;
     if (!shift.isZero()) {
       depth = std::max<Real>(thickness - before.distance, shift.norm());

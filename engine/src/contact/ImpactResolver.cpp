@@ -71,9 +71,14 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
   for (Index k = 0; k < Index(colliders.size()); ++k) {
     Aabb box = path;
     if (!colliders[k].still()) {
+      // A turning body: the paths relative to it are arcs, which stray from their chords.
+      Real bulge = 0;
       for (Index i = 0; i < space.vertexCount(); ++i) {
-        if (space.inverseMass[i] != 0) box.expand(colliders[k].carry(space.startX[i]));
+        if (space.inverseMass[i] == 0) continue;
+        box.expand(colliders[k].carry(space.startX[i]));
+        bulge = std::max(bulge, pathBulge(colliders[k], space.startX[i], space.x[i]));
       }
+      box.inflate(bulge);
     }
     if (!m_skip || mayTouch(colliders[k].shape, box, thickness * (1 + 1e-6) + 1e-9)) {
       m_near.push_back(k);
