@@ -417,10 +417,38 @@ void Cloth::integrate(Real t, Real h, std::span<const SolveConstraint> constrain
     }
   }
   m_integrator->step(*this, m_positions, m_velocities, t, h, report);
-  m_solvePairs.clear();
   m_contactCouplings.clear();
+  if (!m_solvePairs.empty()) {
+    // Each pair's penalty at the end of the step, k (d₀ − d(x₁)) (backward Euler's force), as the
+    // change of its normal relative velocity over the substep: friction's bound.
+    const Real k = m_selfContactStiffness;
+    const Real thickness = m_settings.material.thickness;
+    for (SelfContactPair& pair : m_solvePairs) {
+      Vec3 point = Vec3::Zero();
+      Real inverseMass = 0;
+      for (int j = 0; j < 4; ++j) {
+        point += pair.weights[j] * m_positions[pair.vertices[j]];
+        inverseMass += pair.weights[j] * pair.weights[j] * m_inverseMasses[pair.vertices[j]];
+      }
+      const Real overlap = thickness - pair.normal.dot(point);
+      pair.solveImpulse = overlap > 0 ? h * k * overlap * inverseMass : 0;
+    }
+    std::sort(m_solvePairs.begin(), m_solvePairs.end(),
+              [](const SelfContactPair& a, const SelfContactPair& b) {
+                return selfContactBefore(a.kind, a.vertices, b.kind, b.vertices);
+              });
+  }
   m_constraints = {};
   m_normalsValid = false;
+}
+
+Real Cloth::selfContactImpulse(ContactKind kind, const std::array<Index, 4>& vertices) const {
+  const auto found = std::lower_bound(
+      m_solvePairs.begin(), m_solvePairs.end(), 0, [&](const SelfContactPair& pair, int) {
+        return selfContactBefore(pair.kind, pair.vertices, kind, vertices);
+      });
+  if (found == m_solvePairs.end() || found->kind != kind || found->vertices != vertices) return 0;
+  return found->solveImpulse;
 }
 
 void Cloth::endFrame() {

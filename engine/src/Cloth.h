@@ -98,6 +98,9 @@ class Cloth final : public DynamicSystem {
   void setSelfContacts(std::span<const SelfContactFeatures> features) {
     m_selfContacts.assign(features.begin(), features.end());
   }
+  /// m/s: the normal velocity change the last solve's penalty gave the self-contact pair of
+  /// `kind` and (this cloth's) `vertices`; 0 when the solve held no such pair.
+  Real selfContactImpulse(ContactKind kind, const std::array<Index, 4>& vertices) const;
   /// Takes the contact stages' corrected state (one entry per vertex).
   void setContactResult(std::span<const Vec3> positions, std::span<const Vec3> velocities);
 
@@ -227,7 +230,7 @@ class Cloth final : public DynamicSystem {
   // for a retry), this substep's pairs at its start, their terms; k in N/m (0: an explicit
   // integrator, which takes no terms).
   std::vector<SelfContactFeatures> m_selfContacts, m_frameStartSelfContacts;
-  std::vector<SelfContactPair> m_solvePairs;
+  std::vector<SelfContactPair> m_solvePairs;  // in selfContactBefore order after the solve
   std::vector<ContactCoupling> m_contactCouplings;
   Real m_selfContactStiffness = 0;
   ClothStageCounts m_stageCounts;

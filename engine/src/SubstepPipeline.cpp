@@ -294,6 +294,16 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   const bool pairs = m_planner.pairsNeeded(m_space, m_stepping, selfNeeded, selfSkipped);
   m_detector.detect(m_space, m_colliders, m_solveImpulses, m_constrainedCollider, pairs,
                     m_contactMargin, m_contacts, counts);
+  // The pairs the solve held: their penalty's impulse is their friction bound.
+  const std::span<Cloth* const> solved = m_space.cloths();
+  for (std::size_t k = m_contacts.firstPair; k < m_contacts.size(); ++k) {
+    Contact& contact = m_contacts.contacts[k];
+    const Index c = m_space.owner[contact.vertices[0]];
+    if (m_space.owner[contact.vertices[3]] != c || !m_stepping[c]) continue;
+    std::array<Index, 4> local = contact.vertices;
+    for (Index& vertex : local) vertex -= m_space.firstVertex(c);
+    contact.solveImpulse = solved[c]->selfContactImpulse(contact.kind, local);
+  }
   m_solvedPositions = m_space.x;
   ProjectionReport projected =
       m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);

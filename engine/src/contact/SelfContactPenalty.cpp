@@ -14,6 +14,7 @@ std::optional<SelfContactPair> selfContactAt(const SelfContactFeatures& features
                                              std::span<const Vec3> x, Real reach) {
   const std::array<Index, 4>& v = features.vertices;
   SelfContactPair pair;
+  pair.kind = features.kind;
   pair.vertices = v;
   Vec3 between = Vec3::Zero();
   Real distance = 0;

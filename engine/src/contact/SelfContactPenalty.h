@@ -12,6 +12,11 @@
 // deep pushes as hard as an edge stretched by its thickness). The projection and the impact pass
 // still have the last word.
 //
+// Friction. A pair the solve holds apart is pushed by its penalty, not by the projection, so the
+// velocity change the penalty gave at the end of the step, k (d₀ − d(x₁)) h Σ w_k² / m_k, is the
+// pair's share of friction's bound (ContactProjector), as the constraint impulse is a collider
+// contact's: layers held by the solve grip each other by the cloth's friction.
+//
 // The pairs. The features (vertex–face, edge–edge) of the last substep's pairs are kept with the
 // cloth, so they are part of its saved state; at the start of a substep their closest points,
 // weights and normal are taken again at the start positions, which are free of crossings, so a
@@ -44,11 +49,23 @@ struct SelfContactFeatures {
 /// A pair at given positions: Σ w_k x_k is the first side minus the second, n points from the
 /// second side to the first, and d = n · Σ w_k x_k is its gap (m).
 struct SelfContactPair {
+  ContactKind kind = ContactKind::VertexFace;
   std::array<Index, 4> vertices{};
   std::array<Real, 4> weights{};
   Vec3 normal = Vec3::Zero();
   Real gap = 0;
+  /// m/s, the change of the pair's normal relative velocity its penalty gave in the solve (set
+  /// after the solve): the friction bound of the pair's contact, as a collider contact's
+  /// Contact::solveImpulse.
+  Real solveImpulse = 0;
 };
+
+/// Orders pairs by kind, then vertices: the key a detected contact finds its solve pair by.
+inline bool selfContactBefore(ContactKind kindA, const std::array<Index, 4>& verticesA,
+                              ContactKind kindB, const std::array<Index, 4>& verticesB) {
+  if (kindA != kindB) return kindA < kindB;
+  return verticesA < verticesB;
+}
 
 /// The pair of `features` at positions `x` (closest points), or nothing when its gap is `reach`
 /// (m) or more or the pair is degenerate. A pure kernel.
