@@ -255,7 +255,8 @@ void Cloth::addSelfContactTerms(const Vec3Array& x, Real h, const Vec3Array& vel
     Vec3 relative = Vec3::Zero();
     for (int j = 0; j < 4; ++j) relative += pair.weights[j] * velocityForProduct[pair.vertices[j]];
     ContactCoupling term{pair.vertices, pair.weights, pair.normal, h * h * k, 0, 0};
-    term.force = contactPenalty(corners, pair.weights, pair.normal, thickness, k).force;
+    const Real restGap = penaltyRestGap(pair.gap, thickness);
+    term.force = contactPenalty(corners, pair.weights, pair.normal, restGap, k).force;
     term.stiffnessTimesVelocity = -k * pair.normal.dot(relative);
     m_contactCouplings.push_back(term);
   }
@@ -430,7 +431,7 @@ void Cloth::integrate(Real t, Real h, std::span<const SolveConstraint> constrain
         point += pair.weights[j] * m_positions[pair.vertices[j]];
         inverseMass += pair.weights[j] * pair.weights[j] * m_inverseMasses[pair.vertices[j]];
       }
-      const Real overlap = thickness - pair.normal.dot(point);
+      const Real overlap = penaltyRestGap(pair.gap, thickness) - pair.normal.dot(point);
       pair.solveImpulse = overlap > 0 ? h * k * overlap * inverseMass : 0;
     }
     std::sort(m_solvePairs.begin(), m_solvePairs.end(),

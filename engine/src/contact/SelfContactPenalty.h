@@ -29,6 +29,7 @@
 // pairs of the last substep are the same pairs but for those that just came within reach.
 #pragma once
 
+#include "contact/ContactDetector.h"
 #include "contact/ContactSet.h"
 
 #include <weft/Math.h>
@@ -65,6 +66,14 @@ inline bool selfContactBefore(ContactKind kindA, const std::array<Index, 4>& ver
                               ContactKind kindB, const std::array<Index, 4>& verticesB) {
   if (kindA != kindB) return kindA < kindB;
   return verticesA < verticesB;
+}
+
+/// m: the gap the penalty of a pair `startGap` apart at the substep start keeps: the thickness, or
+/// for a pair closer than that the repulsion rate's share of the way back to it, as the
+/// projection asks (a sandwiched layer pressed tighter than two thicknesses cannot be pushed to
+/// both at once; a spring that insisted would pump the energy of the fold every substep).
+inline Real penaltyRestGap(Real startGap, Real thickness) {
+  return startGap < thickness ? startGap + kRepulsionRate * (thickness - startGap) : thickness;
 }
 
 /// The pair of `features` at positions `x` (closest points), or nothing when its gap is `reach`
