@@ -412,6 +412,11 @@ void Cloth::integrate(Real t, Real h, std::span<const SolveConstraint> constrain
   if (m_selfContactStiffness > 0) {
     const Real reach = kPairReach * m_settings.material.thickness;
     for (const SelfContactFeatures& features : m_selfContacts) {
+      // A pair with a pinned vertex is left to the projection (SelfContactPenalty.h).
+      if (std::any_of(features.vertices.begin(), features.vertices.end(),
+                      [&](Index vertex) { return m_pinnedMask[vertex] != 0; })) {
+        continue;
+      }
       if (const std::optional<SelfContactPair> pair = selfContactAt(features, m_positions, reach)) {
         m_solvePairs.push_back(*pair);
       }

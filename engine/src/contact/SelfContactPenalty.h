@@ -21,7 +21,10 @@
 // cloth, so they are part of its saved state; at the start of a substep their closest points,
 // weights and normal are taken again at the start positions, which are free of crossings, so a
 // pair's side is the one its points are on now. A pair farther apart than the pairs' reach is no
-// term. A cloth without self-contacts has no features and pays nothing.
+// term. A cloth without self-contacts has no features and pays nothing. A pair with a pinned
+// vertex is no term either: the solve cannot move the pinned side, so the whole push lands on the
+// free one, and a sheet crushed onto its own pinned row (pins dragged and stopped) stays hooked
+// over it; the projection holds such pairs with the pinned side immovable.
 //
 // Rejected: the pairs as filter constraints of the solve (a vertex's normal velocity fixed),
 // which fixes a layer's absolute motion where only the relative one is known; a proximity query
