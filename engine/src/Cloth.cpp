@@ -76,6 +76,14 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   m_inverseMasses.resize(n);
   const std::vector<Real>& mass = m_forces.masses();
   for (Index i = 0; i < n; ++i) m_inverseMasses[i] = m_pinnedMask[i] ? 0 : 1 / mass[i];
+  // Self-contacts in an implicit solve: k is the stretch stiffness (SelfContactPenalty.h).
+  if (settings.solver.integrator == IntegratorKind::ImplicitEuler ||
+      settings.solver.integrator == IntegratorKind::Bdf2) {
+    m_selfContactStiffness = settings.forceModel == ForceModel::MassSpring
+                                 ? settings.springs.structuralStiffness
+                                 : std::max(settings.material.warpStretchStiffness,
+                                            settings.material.weftStretchStiffness);
+  }
   estimateStiffestMode();
 }
 
@@ -227,8 +235,31 @@ Real Cloth::linearize(const Vec3Array& x, const Vec3Array& v, Real, Real h, Vec3
                       const Vec3Array& velocityForProduct, Vec3Array& stiffnessTimesVelocity) {
   m_stageCounts.bendingAssemblies += m_forces.evaluatesBending();
   m_stageCounts.dampingJacobians += m_forces.formsDampingJacobians();
-  return m_forces.assemble(x, v, h, m_matrix, f, velocityForProduct, stiffnessTimesVelocity,
-                           &m_pinnedCoupling);
+  const Real energy = m_forces.assemble(x, v, h, m_matrix, f, velocityForProduct,
+                                        stiffnessTimesVelocity, &m_pinnedCoupling);
+  addSelfContactTerms(x, h, velocityForProduct);
+  return energy;
+}
+
+void Cloth::addSelfContactTerms(const Vec3Array& x, Real h, const Vec3Array& velocityForProduct) {
+  // Every pair gives a term (ContactCoupling.h: h² k JᵀJ, the spring's normal force at x and
+  // ∂f/∂x·v = −k J v), zero or pulling where it is apart: the integrator adds the forces to the
+  // right-hand side itself and keeps a term only while it pushes at the end of the step. The
+  // penalty's energy is no part of the reported potential: it is a device of the solve.
+  m_contactCouplings.clear();  // keeps its capacity
+  const Real k = m_selfContactStiffness;
+  const Real thickness = m_settings.material.thickness;
+  for (const SelfContactPair& pair : m_solvePairs) {
+    const std::array<Vec3, 4> corners{x[pair.vertices[0]], x[pair.vertices[1]],
+                                      x[pair.vertices[2]], x[pair.vertices[3]]};
+    Vec3 relative = Vec3::Zero();
+    for (int j = 0; j < 4; ++j) relative += pair.weights[j] * velocityForProduct[pair.vertices[j]];
+    ContactCoupling term{pair.vertices, pair.weights, pair.normal, h * h * k, 0, 0};
+    const Real restGap = penaltyRestGap(pair.gap, thickness);
+    term.force = contactPenalty(corners, pair.weights, pair.normal, restGap, k).force;
+    term.stiffnessTimesVelocity = -k * pair.normal.dot(relative);
+    m_contactCouplings.push_back(term);
+  }
 }
 
 void Cloth::applyPrescribedMotion(Real t, Vec3Array& x, Vec3Array& v) const {
@@ -297,6 +328,7 @@ Status Cloth::setState(std::span<const Vec3> positions, std::span<const Vec3> ve
   const std::vector<Index>& pins = m_settings.pinnedVertices;
   for (std::size_t k = 0; k < pins.size(); ++k) m_pinStart[k] = m_pinEnd[k] = m_positions[pins[k]];
   m_integrator->reset();  // the previous Δv means nothing for the new state
+  m_selfContacts.clear();  // nor the previous pairs
   m_normalsValid = false;
   m_sleep.sleeping = false;
   m_sleep.quietFrames = 0;
@@ -356,6 +388,7 @@ bool Cloth::beginFrame(Real t, Real frameDt, const StepPlan& plan) {
   m_frameStartVelocities = m_velocities;
   m_integrator->saveCarriedState(m_frameStartCarried);
   m_frameStartJammed = m_jammed;
+  m_frameStartSelfContacts = m_selfContacts;
   m_normalsValid = false;
   return teleported;
 }
@@ -374,9 +407,54 @@ void Cloth::integrate(Real t, Real h, std::span<const SolveConstraint> constrain
   m_constraints = constraints;
   m_firstVertex = firstVertex;
   std::fill(m_solveContactImpulses.begin(), m_solveContactImpulses.end(), Real(0));
+  // The last substep's self-contact pairs at this substep's start (SelfContactPenalty.h).
+  m_solvePairs.clear();
+  if (m_selfContactStiffness > 0) {
+    const Real reach = kPairReach * m_settings.material.thickness;
+    for (const SelfContactFeatures& features : m_selfContacts) {
+      // A pair with a pinned vertex is left to the projection (SelfContactPenalty.h).
+      if (std::any_of(features.vertices.begin(), features.vertices.end(),
+                      [&](Index vertex) { return m_pinnedMask[vertex] != 0; })) {
+        continue;
+      }
+      if (const std::optional<SelfContactPair> pair = selfContactAt(features, m_positions, reach)) {
+        m_solvePairs.push_back(*pair);
+      }
+    }
+  }
   m_integrator->step(*this, m_positions, m_velocities, t, h, report);
+  m_contactCouplings.clear();
+  if (!m_solvePairs.empty()) {
+    // Each pair's penalty at the end of the step, k (d₀ − d(x₁)) (backward Euler's force), as the
+    // change of its normal relative velocity over the substep: friction's bound.
+    const Real k = m_selfContactStiffness;
+    const Real thickness = m_settings.material.thickness;
+    for (SelfContactPair& pair : m_solvePairs) {
+      Vec3 point = Vec3::Zero();
+      Real inverseMass = 0;
+      for (int j = 0; j < 4; ++j) {
+        point += pair.weights[j] * m_positions[pair.vertices[j]];
+        inverseMass += pair.weights[j] * pair.weights[j] * m_inverseMasses[pair.vertices[j]];
+      }
+      const Real overlap = penaltyRestGap(pair.gap, thickness) - pair.normal.dot(point);
+      pair.solveImpulse = overlap > 0 ? h * k * overlap * inverseMass : 0;
+    }
+    std::sort(m_solvePairs.begin(), m_solvePairs.end(),
+              [](const SelfContactPair& a, const SelfContactPair& b) {
+                return selfContactBefore(a.kind, a.vertices, b.kind, b.vertices);
+              });
+  }
   m_constraints = {};
   m_normalsValid = false;
+}
+
+Real Cloth::selfContactImpulse(ContactKind kind, const std::array<Index, 4>& vertices) const {
+  const auto found = std::lower_bound(
+      m_solvePairs.begin(), m_solvePairs.end(), 0, [&](const SelfContactPair& pair, int) {
+        return selfContactBefore(pair.kind, pair.vertices, kind, vertices);
+      });
+  if (found == m_solvePairs.end() || found->kind != kind || found->vertices != vertices) return 0;
+  return found->solveImpulse;
 }
 
 void Cloth::endFrame() {
@@ -389,6 +467,7 @@ void Cloth::restoreFrameStart() {
   m_velocities = m_frameStartVelocities;
   m_integrator->restoreCarriedState(m_frameStartCarried);
   m_jammed = m_frameStartJammed;
+  m_selfContacts = m_frameStartSelfContacts;
   m_normalsValid = false;
 }
 
@@ -406,6 +485,7 @@ void Cloth::save(SavedState& out) const {
   out.sleep = m_sleep;
   out.potentialEnergy = m_lastPotential;
   out.jammed = m_jammed;
+  out.selfContacts = m_selfContacts;
 }
 
 void Cloth::restore(const SavedState& in) {
@@ -417,6 +497,7 @@ void Cloth::restore(const SavedState& in) {
   m_sleep = in.sleep;
   m_lastPotential = in.potentialEnergy;
   m_jammed = in.jammed;
+  m_selfContacts = in.selfContacts;
 }
 
 const Vec3Array& Cloth::normals() {

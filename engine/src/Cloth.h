@@ -10,9 +10,11 @@
 #include "ClothForces.h"
 #include "RigidFit.h"
 #include "contact/ContactDetector.h"
+#include "contact/SelfContactPenalty.h"
 #include "integrators/Integrator.h"
 #include "solver/BlockSparseMatrix.h"
 #include "solver/FreeVertexMap.h"
+#include "solver/ContactCoupling.h"
 #include "solver/PinnedCoupling.h"
 #include "solver/VertexFilter.h"
 
@@ -63,6 +65,7 @@ class Cloth final : public DynamicSystem {
   void constrainContacts(const Vec3Array& x, const Vec3Array& v, Real h,
                          VertexFilter& filter) override;
   void receiveContactImpulses(std::span<const Real> byRow) override;
+  std::span<const ContactCoupling> contactCouplings() const override { return m_contactCouplings; }
 
   // --- One frame, driven by the substep pipeline. ---
   /// Starts a frame of length frameDt at world time t: carries the cloth with its pins when they
@@ -90,6 +93,14 @@ class Cloth final : public DynamicSystem {
   void zeroVelocities() {
     for (Vec3& v : m_velocities) v.setZero();
   }
+  /// The self-contact pairs of the last substep (this cloth's vertices), which the next implicit
+  /// solve holds as penalties (contact/SelfContactPenalty.h).
+  void setSelfContacts(std::span<const SelfContactFeatures> features) {
+    m_selfContacts.assign(features.begin(), features.end());
+  }
+  /// m/s: the normal velocity change the last solve's penalty gave the self-contact pair of
+  /// `kind` and (this cloth's) `vertices`; 0 when the solve held no such pair.
+  Real selfContactImpulse(ContactKind kind, const std::array<Index, 4>& vertices) const;
   /// Takes the contact stages' corrected state (one entry per vertex).
   void setContactResult(std::span<const Vec3> positions, std::span<const Vec3> velocities);
 
@@ -137,6 +148,7 @@ class Cloth final : public DynamicSystem {
     ClothSleep sleep;
     Real potentialEnergy = 0;  // J, what a sleeping cloth reports
     bool jammed = false;       // the next substep is hard (tightCgTolerance)
+    std::vector<SelfContactFeatures> selfContacts;  // the next solve's penalties
   };
   void save(SavedState& out) const;
   /// Restores a save of this cloth (sizes checked by the caller).
@@ -177,6 +189,8 @@ class Cloth final : public DynamicSystem {
   // Builds the implicit system's rows, matrix pattern and pin coupling from the pin set; runs at
   // creation, never per step.
   void buildSystemRows();
+  // The penalties of m_solvePairs at x into m_contactCouplings (SelfContactPenalty.h).
+  void addSelfContactTerms(const Vec3Array& x, Real h, const Vec3Array& velocityForProduct);
 
   std::shared_ptr<const ClothModel> m_model;
   TaskSystem* m_tasks;
@@ -212,6 +226,13 @@ class Cloth final : public DynamicSystem {
   Index m_firstVertex = 0;
   std::vector<Index> m_contactRows;
   std::vector<Real> m_solveContactImpulses;  // m/s by vertex
+  // Self-contacts in the solve: the features of the last substep's pairs (and at the frame start,
+  // for a retry), this substep's pairs at its start, their terms; k in N/m (0: an explicit
+  // integrator, which takes no terms).
+  std::vector<SelfContactFeatures> m_selfContacts, m_frameStartSelfContacts;
+  std::vector<SelfContactPair> m_solvePairs;  // in selfContactBefore order after the solve
+  std::vector<ContactCoupling> m_contactCouplings;
+  Real m_selfContactStiffness = 0;
   ClothStageCounts m_stageCounts;
   Real m_stiffestFrequency = 0, m_stiffestDampingRate = 0;
   Real m_stableStep = 0;

@@ -79,6 +79,7 @@ void SubstepPipeline::rebuild(std::span<Cloth* const> cloths) {
   m_startKinetic.assign(cloths.size(), 0);
   m_reports.assign(cloths.size(), IntegratorReport{});
   m_pairContacts.assign(cloths.size(), 0);
+  m_selfContacts.resize(cloths.size());
   m_supports.clear();
 }
 
@@ -293,6 +294,16 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   const bool pairs = m_planner.pairsNeeded(m_space, m_stepping, selfNeeded, selfSkipped);
   m_detector.detect(m_space, m_colliders, m_solveImpulses, m_constrainedCollider, pairs,
                     m_contactMargin, m_contacts, counts);
+  // The pairs the solve held: their penalty's impulse is their friction bound.
+  const std::span<Cloth* const> solved = m_space.cloths();
+  for (std::size_t k = m_contacts.firstPair; k < m_contacts.size(); ++k) {
+    Contact& contact = m_contacts.contacts[k];
+    const Index c = m_space.owner[contact.vertices[0]];
+    if (m_space.owner[contact.vertices[3]] != c || !m_stepping[c]) continue;
+    std::array<Index, 4> local = contact.vertices;
+    for (Index& vertex : local) vertex -= m_space.firstVertex(c);
+    contact.solveImpulse = solved[c]->selfContactImpulse(contact.kind, local);
+  }
   m_solvedPositions = m_space.x;
   ProjectionReport projected =
       m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
@@ -335,8 +346,20 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
     }
   }
   const std::span<Cloth* const> cloths = m_space.cloths();
+  // Each cloth's pairs within itself, which its next solve holds (SelfContactPenalty.h).
+  for (std::vector<SelfContactFeatures>& features : m_selfContacts) features.clear();
+  for (std::size_t k = m_contacts.firstPair; k < m_contacts.size(); ++k) {
+    const Contact& contact = m_contacts.contacts[k];
+    const Index c = m_space.owner[contact.vertices[0]];
+    if (m_space.owner[contact.vertices[3]] != c) continue;
+    const Index first = m_space.firstVertex(c);
+    SelfContactFeatures features{contact.kind, contact.vertices, contact.normal};
+    for (Index& vertex : features.vertices) vertex -= first;
+    m_selfContacts[c].push_back(features);
+  }
   for (std::size_t c = 0; c < cloths.size(); ++c) {
     if (!m_stepping[c]) continue;
+    cloths[c]->setSelfContacts(m_selfContacts[c]);
     // Contact-aware accuracy: a substep dense in cloth contacts makes the next one hard.
     Cloth& cloth = *cloths[c];
     cloth.setJammed(Real(m_pairContacts[c]) >=

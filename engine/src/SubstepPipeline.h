@@ -3,7 +3,9 @@
 //
 //   pose       the colliders as values for the substep (shape posed at its end, both motions)
 //   constrain  collider contacts of the predicted motion, for the implicit solve
-//   solve      each cloth's implicit step (Baraff & Witkin 1998), contacts in the filter S
+//   solve      each cloth's implicit step (Baraff & Witkin 1998), collider contacts in the
+//              filter S, the cloth's self-contacts of the last substep as penalties
+//              (contact/SelfContactPenalty.h)
 //   detect     one ContactSet of the solved motion: vertex/face × collider, cloth pairs
 //   project    strain limit, every contact (separation, Coulomb friction), pins — together
 //   impacts    the fail-safe with the last word: collider paths, swept tests, impact zones
@@ -23,6 +25,7 @@
 #include "contact/ContactSet.h"
 #include "contact/ContactSpace.h"
 #include "contact/ImpactResolver.h"
+#include "contact/SelfContactPenalty.h"
 #include "integrators/Integrator.h"
 
 #include <weft/engine/StepStats.h>
@@ -86,6 +89,7 @@ class SubstepPipeline {
   std::vector<Real> m_startStrain, m_startKinetic;  // per cloth, at the frame start
   std::vector<IntegratorReport> m_reports;       // per cloth, this attempt
   std::vector<Index> m_pairContacts;             // per cloth, this substep
+  std::vector<std::vector<SelfContactFeatures>> m_selfContacts;  // per cloth, this substep
   Real m_contactMargin = 0;
   ProjectionSettings m_projection;
 };

@@ -20,9 +20,6 @@ constexpr Real kPressedShell = 0.01;
 // A face within this fraction of the thickness beyond its reach at the substep start rests on
 // the body: it takes friction on its whole displacement.
 constexpr Real kRestingFaceShell = 0.01;
-// Share of the overlap below the thickness a pair's projection removes in one substep (BFA02
-// use 0.1 for their proximity repulsion).
-constexpr Real kRepulsionRate = 0.1;
 // A pair that passed through itself within the substep is put back on its side this share of its
 // thickness apart (the impact stage's separation).
 constexpr Real kImpactSeparation = 0.25;

@@ -41,6 +41,11 @@ namespace weft {
 /// is known. Features that close at rest are neighbours in the material and never a contact.
 inline constexpr Real kPairReach = 2;
 
+/// A pair that starts a substep closer than its thickness is asked back this fraction of the way
+/// to it in the substep (Bridson, Fedkiw & Anderson 2002's repulsion rate), by the projection and
+/// by the solve's penalty alike.
+inline constexpr Real kRepulsionRate = 0.1;
+
 /// A constraint of the implicit solve: the velocity change of `vertex` along `normal` is fixed
 /// to `normalChange` (m/s), so that its predicted motion ends at the contact distance.
 struct SolveConstraint {

@@ -205,7 +205,7 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
         break;
       case ContactKind::VertexFace:
       case ContactKind::EdgeEdge:
-        depth = projectPair(space, c, contact);
+        depth = projectPair(space, c, contact, h);
         break;
     }
     // A contact counts while it still moves its vertices (pushed out, or friction's stick).
@@ -312,7 +312,8 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   return std::max(depth, change.norm());
 }
 
-Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact) {
+Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact,
+                                   Real h) {
   const auto [inverseMass, weight] = pairInverseMass(contact, space.inverseMass);
   if (!(weight > 0)) return 0;
   Vec3 gap = Vec3::Zero();
@@ -335,13 +336,14 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
       !(shortfall > -kOnSurfaceShell * contact.separation)) {
     return std::max<Real>(0, shortfall);
   }
-  // The budget: how far the projection has moved the pair apart along its normal in all.
+  // The budget: how far the projection has moved the pair apart along its normal in all, plus
+  // h times the solve's push (its self-contact penalty).
   Vec3 apart = Vec3::Zero();
   for (int k = 0; k < 4; ++k) {
     const Index i = contact.vertices[k];
     apart += contact.weights[k] * (space.x[i] - m_solved[i]);
   }
-  const Real budget = std::max<Real>(0, contact.normal.dot(apart));
+  const Real budget = h * contact.solveImpulse + std::max<Real>(0, contact.normal.dot(apart));
   if (!(budget > 0) && m_friction[index].isZero()) return std::max<Real>(0, shortfall);
   // The relative tangential displacement of the two sides over the substep.
   Vec3 slip = Vec3::Zero();

@@ -27,7 +27,8 @@
 // Friction. A contact's friction may remove at most μ D of the tangential displacement of its two
 // sides over the substep, D being its normal displacement: how far the projection has moved its
 // sides apart along its normal, plus h times the solve's contact impulse for a collider contact
-// (the solve carries a resting cloth's weight and the projection then pushes nothing). A contact
+// (the solve carries a resting cloth's weight and the projection then pushes nothing) and for a
+// pair within one cloth (its penalty in the solve holds the layers, SelfContactPenalty.h). A contact
 // that rests at the substep start takes it on its whole tangential displacement relative to the
 // body, so that it sticks without creeping h² a a substep; one that met the body within the
 // substep takes it on its velocity instead (its end is where its path slid on from the hit, not
@@ -93,7 +94,7 @@ class ContactProjector {
                      const ColliderFrame& collider, Real h);
   Real projectFace(ContactSpace& space, std::size_t index, const Contact& contact,
                    const ContactSet& set, const ColliderFrame& collider, Real h);
-  Real projectPair(ContactSpace& space, std::size_t index, const Contact& contact);
+  Real projectPair(ContactSpace& space, std::size_t index, const Contact& contact, Real h);
   // The final velocity pass and the supports (see the file comment).
   Index finish(ContactSpace& space, const ContactSet& set, std::span<const ColliderFrame> colliders,
                std::vector<FaceSupport>& supports);

@@ -59,8 +59,9 @@ struct Contact {
   /// body's frame (zero when the face started on the core): the side it must go back to.
   Index collider = kInvalidIndex;
   Index core = kInvalidIndex;
-  /// m/s, the normal velocity change the implicit solve's constraint gave the contact (collider
-  /// kinds; 0 when the solve did not constrain it). Part of the friction bound.
+  /// m/s, the normal velocity change the implicit solve gave the contact: a collider contact's
+  /// constraint, a pair's self-contact penalty (0 when the solve held neither). Part of the
+  /// friction bound.
   Real solveImpulse = 0;
   /// True when the contact began the substep touching (within the contact shell): friction then
   /// acts on the substep's whole tangential displacement, so a resting contact does not creep.
