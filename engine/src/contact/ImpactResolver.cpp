@@ -93,8 +93,7 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
     bool moved = false;
     for (Index k : m_near) {
       const ColliderFrame& collider = colliders[k];
-      const Vec3 outside = keepOutsideFrom(collider.shape, traceStart(i, collider, space),
-                                           space.x[i], thickness);
+      const Vec3 outside = keepVertexOutside(i, collider, space, space.x[i], thickness);
       if (outside == space.x[i]) continue;
       space.x[i] = outside;
       // Inelastic: no relative velocity into the surface.
@@ -139,9 +138,11 @@ Real ImpactResolver::impulseInverseMass(Index vertex, const ContactSpace& space)
   return m_held[vertex] ? kHeldInverseMassScale * inverseMass : inverseMass;
 }
 
-Vec3 ImpactResolver::traceStart(Index vertex, const ColliderFrame& collider,
-                                const ContactSpace& space) const {
-  return m_tracked[vertex] ? m_projected[vertex] : collider.carry(space.startX[vertex]);
+Vec3 ImpactResolver::keepVertexOutside(Index vertex, const ColliderFrame& collider,
+                                       const ContactSpace& space, const Vec3& end,
+                                       Real thickness) const {
+  if (m_tracked[vertex]) return keepOutsideFrom(collider.shape, m_projected[vertex], end, thickness);
+  return keepOutside(collider, space.startX[vertex], end, thickness);
 }
 
 void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
@@ -153,9 +154,7 @@ void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
       // The way there, relative to the body, not only the end: an impulse may send a vertex
       // through a thin or fast body.
       const Vec3 end = space.startX[i] + h * m_velocity[i];
-      const Vec3 outside =
-          keepOutsideFrom(m_colliders[k].shape, traceStart(i, m_colliders[k], space), end,
-                          thickness);
+      const Vec3 outside = keepVertexOutside(i, m_colliders[k], space, end, thickness);
       if (outside != end) m_velocity[i] = (outside - space.startX[i]) / h;
     }
   }

@@ -93,8 +93,11 @@ class ImpactResolver {
   void rigidifyZones(const ContactSpace& space);
   Real impulseInverseMass(Index vertex, const ContactSpace& space);
   void clampToColliders(const ContactSpace& space, Real h);
-  // Where a vertex's way to its end is traced from against `collider` (body end frame).
-  Vec3 traceStart(Index vertex, const ColliderFrame& collider, const ContactSpace& space) const;
+  // keepOutside() for `vertex` ending at `end`: traced from where the projection left it when
+  // the projection followed it as a collider contact (the body at its end pose), else over the
+  // substep from x₀.
+  Vec3 keepVertexOutside(Index vertex, const ColliderFrame& collider, const ContactSpace& space,
+                         const Vec3& end, Real thickness) const;
 
   TaskSystem* m_tasks = nullptr;
   bool m_skip = true;
