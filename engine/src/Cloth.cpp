@@ -54,7 +54,8 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   m_frameStartPositions = m_positions;
   m_frameStartVelocities = m_velocities;
   m_solveContactImpulses.assign(n, 0);
-  m_frameStartCarried.reserve(n);  // the integrator's warm start, copied at every frame start
+  // The integrator's carried state, copied at every frame start.
+  m_frameStartCarried.reserve(m_integrator->carriedStateCapacity(std::size_t(n)));
 
   // Pins start where their vertices are.
   const std::vector<Index>& pins = settings.pinnedVertices;
