@@ -10,17 +10,72 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <utility>
 
 namespace weft {
 namespace {
 
+// Triangles per leaf of the collider's tree: a point query prunes by box, and small boxes prune
+// most (the cloth's self query wants large leaves instead, Bvh::kMaxLeafTriangles).
+constexpr Index kLeafTriangles = 4;
+
 std::string describeTriangle(Index t, Index a, Index b, Index c) {
   std::ostringstream text;
   text << "TriangleMeshShape: triangle " << t << " (vertices " << a << ", " << b << ", " << c
        << ")";
   return text.str();
+}
+
+// |p − closest point of triangle (a, b, c)|²: the Voronoi-region walk of closestPointOnTriangle
+// without the square root and the result record, for the many triangles a search rejects. The
+// winner is measured again with closestPointOnTriangle for its exact features.
+Real squaredDistanceToTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  const Vec3 ap = p - a;
+  const Real d1 = ab.dot(ap);
+  const Real d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
+  const Vec3 bp = p - b;
+  const Real d3 = ab.dot(bp);
+  const Real d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - (d1 / (d1 - d3)) * ab).squaredNorm();
+  const Vec3 cp = p - c;
+  const Real d5 = ab.dot(cp);
+  const Real d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - (d2 / (d2 - d6)) * ac).squaredNorm();
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return (bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)).squaredNorm();
+  }
+  const Real inverse = 1 / (va + vb + vc);
+  return (ap - (vb * inverse) * ab - (vc * inverse) * ac).squaredNorm();
+}
+
+// True when segment a → a + travel meets box (slab test; a zero component of travel is a slab
+// the segment is either in or out of).
+bool segmentMeetsBox(const Vec3& a, const Vec3& travel, const Aabb& box) {
+  Real enter = 0, leave = 1;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (travel[axis] == 0) {
+      if (a[axis] < box.min[axis] || a[axis] > box.max[axis]) return false;
+      continue;
+    }
+    const Real inverse = 1 / travel[axis];
+    Real near = (box.min[axis] - a[axis]) * inverse;
+    Real far = (box.max[axis] - a[axis]) * inverse;
+    if (near > far) std::swap(near, far);
+    enter = std::max(enter, near);
+    leave = std::min(leave, far);
+    if (enter > leave) return false;
+  }
+  return true;
 }
 
 Real cornerAngle(const Vec3& corner, const Vec3& next, const Vec3& previous) {
@@ -82,18 +137,20 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
   if (Status status = shape.setMotion(motion); !status) return status.error();
   shape.m_localVertices.assign(localVertices.begin(), localVertices.end());
   shape.m_indices.assign(indices.begin(), indices.end());
-  Result<Bvh> tree = Bvh::build(shape.m_indices, shape.m_localVertices);
+  Result<Bvh> tree = Bvh::build(shape.m_indices, shape.m_localVertices, kLeafTriangles);
   if (!tree) return tree.error();
   shape.m_localBvh = std::move(tree).value();
 
   // Face normals, angle-weighted vertex normals.
   const auto& x = shape.m_localVertices;
   shape.m_faceNormals.resize(triangleCount);
+  shape.m_corners.resize(3 * std::size_t(triangleCount));
   shape.m_vertexNormals.assign(x.size(), Vec3::Zero());
   for (Index t = 0; t < triangleCount; ++t) {
     const Index corner[3] = {indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]};
     const Vec3 normal = (x[corner[1]] - x[corner[0]]).cross(x[corner[2]] - x[corner[0]]).normalized();
     shape.m_faceNormals[t] = normal;
+    for (int k = 0; k < 3; ++k) shape.m_corners[3 * t + k] = x[corner[k]];
     for (int k = 0; k < 3; ++k) {
       const Real angle = cornerAngle(x[corner[k]], x[corner[(k + 1) % 3]], x[corner[(k + 2) % 3]]);
       shape.m_vertexNormals[corner[k]] += angle * normal;
@@ -115,6 +172,7 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
   }
   std::sort(edgeSlots.begin(), edgeSlots.end());
   shape.m_edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
+  shape.m_closed = true;
   for (std::size_t begin = 0; begin < edgeSlots.size();) {
     std::size_t end = begin;
     Vec3 sum = Vec3::Zero();
@@ -122,6 +180,8 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
       sum += shape.m_faceNormals[edgeSlots[end].second / 3];
       ++end;
     }
+    // Closed: every edge has exactly two triangles (a border edge has one, a fin three or more).
+    if (end - begin != 2) shape.m_closed = false;
     if (sum.squaredNorm() > 0) sum.normalize();
     for (std::size_t i = begin; i < end; ++i) shape.m_edgeNormals[edgeSlots[i].second] = sum;
     begin = end;
@@ -142,14 +202,11 @@ Status TriangleMeshShape::setMotion(const RigidMotion& motion) {
   return Status::success();
 }
 
-ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
-  const Vec3 local = m_motion.pose.toLocal(point);
+Index TriangleMeshShape::closestTriangle(const Vec3& local, Real maxSquared) const {
   const std::vector<Bvh::Node>& nodes = m_localBvh.nodes();
-
   // Best-first descent with a fixed stack (one pending sibling per level).
-  Real bestSquared = std::numeric_limits<Real>::infinity();
+  Real bestSquared = maxSquared;
   Index bestTriangle = kInvalidIndex;
-  TriangleClosestPoint best;
   Index stack[64];
   int top = 0;
   stack[top++] = 0;
@@ -158,14 +215,14 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
     if (node.bounds.squaredDistanceTo(local) >= bestSquared) continue;
     if (node.isLeaf()) {
       for (Index t : m_localBvh.leafTriangles(node)) {
-        const TriangleClosestPoint candidate = closestPointOnTriangle(
-            local, m_localVertices[m_indices[3 * t]], m_localVertices[m_indices[3 * t + 1]],
-            m_localVertices[m_indices[3 * t + 2]]);
-        const Real squared = candidate.distance * candidate.distance;
+        const Vec3* corner = &m_corners[3 * t];
+        // The distance to the triangle's plane bounds the distance to the triangle from below.
+        const Real plane = m_faceNormals[t].dot(local - corner[0]);
+        if (plane * plane >= bestSquared) continue;
+        const Real squared = squaredDistanceToTriangle(local, corner[0], corner[1], corner[2]);
         // Strictly closer only: among equal distances the first one found (a fixed order) wins.
         if (squared < bestSquared) {
           bestSquared = squared;
-          best = candidate;
           bestTriangle = t;
         }
       }
@@ -182,24 +239,77 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
       }
     }
   }
+  return bestTriangle;
+}
+
+ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
+  const Vec3 local = m_motion.pose.toLocal(point);
+  return contactWith(local, closestTriangle(local, std::numeric_limits<Real>::infinity()));
+}
+
+std::optional<ShapeContact> TriangleMeshShape::queryPointWithin(const Vec3& point,
+                                                                Real maxDistance) const {
+  const Vec3 local = m_motion.pose.toLocal(point);
+  const Index triangle = closestTriangle(local, maxDistance * maxDistance);
+  if (triangle == kInvalidIndex) return std::nullopt;
+  const ShapeContact contact = contactWith(local, triangle);
+  if (!(std::abs(contact.distance) < maxDistance)) return std::nullopt;
+  return contact;
+}
+
+ShapeContact TriangleMeshShape::contactWith(const Vec3& local, Index triangle) const {
+  const Vec3* corner = &m_corners[3 * triangle];
+  const TriangleClosestPoint best = closestPointOnTriangle(local, corner[0], corner[1], corner[2]);
+  const Vec3 offset = local - best.point;
+  if (!m_closed) {
+    // A two-sided shell: the unsigned distance, the normal towards the side the point is on.
+    const Vec3 normal = best.distance > 0 ? Vec3(offset / best.distance) : m_faceNormals[triangle];
+    return detail::worldContact(m_motion, best.distance, normal, best.point);
+  }
 
   // Pseudo-normal of the closest feature: vertex (one weight is 1), edge (one weight is 0), face.
   const Vec3& w = best.barycentric;
-  Vec3 pseudoNormal = m_faceNormals[bestTriangle];
+  Vec3 pseudoNormal = m_faceNormals[triangle];
   for (Index k = 0; k < 3; ++k) {
     if (w[k] == 1) {
-      pseudoNormal = m_vertexNormals[m_indices[3 * bestTriangle + k]];
+      pseudoNormal = m_vertexNormals[m_indices[3 * triangle + k]];
       break;
     }
     if (w[k] == 0) {
       // The edge opposite corner k runs from corner k+1 to corner k+2: edge slot (k + 1) % 3.
-      pseudoNormal = m_edgeNormals[3 * bestTriangle + (k + 1) % 3];
+      pseudoNormal = m_edgeNormals[3 * triangle + (k + 1) % 3];
     }
   }
-  const Vec3 offset = local - best.point;
   const Real side = offset.dot(pseudoNormal) < 0 ? -1.0 : 1.0;
   const Vec3 normal = best.distance > 0 ? Vec3(side * offset / best.distance) : pseudoNormal;
   return detail::worldContact(m_motion, side * best.distance, normal, best.point);
+}
+
+std::optional<Real> TriangleMeshShape::firstCrossing(const Vec3& start, const Vec3& end) const {
+  const Vec3 a = m_motion.pose.toLocal(start);
+  const Vec3 travel = m_motion.pose.toLocal(end) - a;
+  const std::vector<Bvh::Node>& nodes = m_localBvh.nodes();
+  Real first = std::numeric_limits<Real>::infinity();
+  Index stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Bvh::Node& node = nodes[stack[--top]];
+    if (!segmentMeetsBox(a, travel, node.bounds)) continue;
+    if (!node.isLeaf()) {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+      continue;
+    }
+    for (Index t : m_localBvh.leafTriangles(node)) {
+      const Vec3* corner = &m_corners[3 * t];
+      const SegmentTriangleClosestPoints hit = closestPointsOnSegmentAndTriangle(
+          a, a + travel, corner[0], corner[1], corner[2]);
+      if (hit.distance == 0) first = std::min(first, hit.segmentParameter);
+    }
+  }
+  if (first > 1) return std::nullopt;
+  return first;
 }
 
 Aabb TriangleMeshShape::bounds() const {

@@ -64,8 +64,11 @@ Index ColliderResponse::constrain(std::span<const ColliderFrame> colliders, cons
         // sheet on top of a 15 cm sphere that pulls away sideways by 6.7 cm in a step ends
         // 1.7 cm clear of it, and the plane put it 0.5 mm inside, so the solve held it against
         // the sheet's tension with an impulse of 36 m/s, which friction then turned into drag.
+        // A two-sided shell (an open mesh) has no inside to show the middle in: there the path
+        // from the hit on is tested for a crossing instead.
         const bool graze = contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
-                           queryPoint(*collider.shape, 0.5 * (hit->point + predicted)).distance > 0;
+                           queryPoint(*collider.shape, 0.5 * (hit->point + predicted)).distance > 0 &&
+                           !shellCrossing(*collider.shape, hit->point, predicted);
         if (!graze) {
           direction = hit->normal;
           depth = hit->distance + hit->normal.dot(predicted - hit->point);
@@ -91,13 +94,17 @@ void ColliderResponse::release(VertexFilter& filter) {
 
 std::optional<PathContact> firstContact(const Shape& shape, const Vec3& a, const Vec3& b,
                                         Real thickness) {
-  const Real startDistance = queryPoint(shape, a).distance;
+  const Vec3 travel = b - a;
+  const Real length = travel.norm();
+  // A start farther from the surface than the path is long plus the thickness stays clear: the
+  // bounded query lets a mesh prune its search to that distance.
+  const std::optional<ShapeContact> start = queryPointWithin(shape, a, length + thickness);
+  if (!start) return std::nullopt;  // far outside, or deep inside
+  const Real startDistance = start->distance;
   if (!(startDistance > 0)) return std::nullopt;  // starts inside: only a projection can help
   // A path that starts within the thickness (a vertex in resting contact) is stopped where it
   // gets halfway from there to the surface: it may move about in the shell, never through it.
   const Real level = startDistance >= thickness ? thickness : 0.5 * startDistance;
-  const Vec3 travel = b - a;
-  const Real length = travel.norm();
   if (length == 0) return std::nullopt;
   // Sphere tracing: the shapes return exact Euclidean distances, so stepping by the distance
   // minus half the level never steps over the level set. A path that starts in the shell steps
@@ -106,17 +113,25 @@ std::optional<PathContact> firstContact(const Shape& shape, const Vec3& a, const
   // sliding vertex. That minimum can cut a dip below the level shorter than a quarter thickness,
   // never a crossing of a body thicker than that: a sample beyond the surface is found. A path
   // still not through after the step budget is stopped where it got (early rather than
-  // through: the caller slides it on from there).
+  // through: the caller slides it on from there). A two-sided shell (an open mesh) has no
+  // beyond with a negative distance: a minimum step longer than the distance allows is tested
+  // for a crossing, and a path that crosses stops at the sample before it, on its side.
   constexpr int kMaxSteps = 256;
   const Real minimumStep = 0.25 * thickness;
+  const bool twoSided = isTwoSided(shape);
   Real s = 0;
   for (int step = 0; step < kMaxSteps; ++step) {
     const Vec3 point = a + s * travel;
-    const ShapeContact contact = queryPoint(shape, point);
+    const ShapeContact contact = step == 0 ? *start : queryPoint(shape, point);
     if (contact.distance < level || step + 1 == kMaxSteps) {
       return PathContact{s, point, contact.normal, contact.distance};
     }
-    s += std::max(contact.distance - 0.5 * level, minimumStep) / length;
+    const Real safeStep = contact.distance - 0.5 * level;
+    if (twoSided && safeStep < minimumStep &&
+        shellCrossing(shape, point, a + std::min<Real>(1, s + minimumStep / length) * travel)) {
+      return PathContact{s, point, contact.normal, contact.distance};
+    }
+    s += std::max(safeStep, minimumStep) / length;
     if (s > 1) {
       // The end itself, which the last step may have passed over.
       const ShapeContact end = queryPoint(shape, b);
