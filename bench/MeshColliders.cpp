@@ -12,6 +12,8 @@
 // The configurations alternate (A, M, A, M, …) so that a machine shared with other jobs slows
 // both alike; a run's cost is the calling thread's CPU time per frame of World::step (and the
 // wall time), the smallest of the repeats is kept, and every repeat's M / A ratio is printed.
+#include "BenchClock.h"
+
 #include <weft/collision/Box.h>
 #include <weft/collision/Sphere.h>
 #include <weft/collision/TriangleMeshShape.h>
@@ -31,17 +33,8 @@
 namespace weft {
 namespace {
 
-double threadCpuMs() {
-  timespec time{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &time);
-  return 1e3 * static_cast<double>(time.tv_sec) + 1e-6 * static_cast<double>(time.tv_nsec);
-}
-
-double wallMs() {
-  timespec time{};
-  clock_gettime(CLOCK_MONOTONIC, &time);
-  return 1e3 * static_cast<double>(time.tv_sec) + 1e-6 * static_cast<double>(time.tv_nsec);
-}
+using bench::threadCpuMs;
+using bench::wallMs;
 
 struct Mesh {
   std::vector<Vec3> vertices;
