@@ -9,6 +9,8 @@
 // report gives, per scene: PCG iterations per solve (mean, max), solves at the cap, solve ms
 // (World's own wall-clock measure), simulation CPU ms per frame and the ratios G / J, and the
 // curtain's state hash per preconditioner (thread-count independent; compare with weft-curtain).
+#include "BenchClock.h"
+
 #include <weft/scenes/Curtain.h>
 
 #include <CLI/CLI.hpp>
@@ -24,17 +26,8 @@
 namespace weft {
 namespace {
 
-double threadCpuMs() {
-  timespec time{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &time);
-  return 1e3 * static_cast<double>(time.tv_sec) + 1e-6 * static_cast<double>(time.tv_nsec);
-}
-
-double wallMs() {
-  timespec time{};
-  clock_gettime(CLOCK_MONOTONIC, &time);
-  return 1e3 * static_cast<double>(time.tv_sec) + 1e-6 * static_cast<double>(time.tv_nsec);
-}
+using bench::threadCpuMs;
+using bench::wallMs;
 
 struct RunFigures {
   long solves = 0;

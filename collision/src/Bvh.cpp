@@ -27,10 +27,11 @@ struct BuildNode {
 };
 
 Index buildRecursive(std::vector<BuildNode>& nodes, std::vector<Index>& order,
-                     const std::vector<Vec3>& centroids, Index begin, Index end) {
+                     const std::vector<Vec3>& centroids, Index begin, Index end,
+                     Index maxLeafTriangles) {
   const Index self = static_cast<Index>(nodes.size());
   nodes.push_back({begin, end, kInvalidIndex, kInvalidIndex});
-  if (end - begin <= Bvh::kMaxLeafTriangles) return self;
+  if (end - begin <= maxLeafTriangles) return self;
 
   Aabb centroidBounds;
   for (Index slot = begin; slot < end; ++slot) centroidBounds.expand(centroids[order[slot]]);
@@ -46,8 +47,8 @@ Index buildRecursive(std::vector<BuildNode>& nodes, std::vector<Index>& order,
     return ca < cb || (ca == cb && a < b);
   });
   const Index middle = begin + (end - begin) / 2;
-  const Index left = buildRecursive(nodes, order, centroids, begin, middle);
-  const Index right = buildRecursive(nodes, order, centroids, middle, end);
+  const Index left = buildRecursive(nodes, order, centroids, begin, middle, maxLeafTriangles);
+  const Index right = buildRecursive(nodes, order, centroids, middle, end, maxLeafTriangles);
   nodes[self].left = left;
   nodes[self].right = right;
   return self;
@@ -63,7 +64,14 @@ std::string describeIndex(std::size_t position, Index value, std::size_t vertexC
 
 }  // namespace
 
-Result<Bvh> Bvh::build(std::span<const Index> triangleIndices, std::span<const Vec3> positions) {
+Result<Bvh> Bvh::build(std::span<const Index> triangleIndices, std::span<const Vec3> positions,
+                       Index maxLeafTriangles) {
+  if (maxLeafTriangles < 1 || maxLeafTriangles > kMaxLeafTriangles) {
+    std::ostringstream text;
+    text << "Bvh: " << maxLeafTriangles << " triangles per leaf is out of range; pass 1 to "
+         << kMaxLeafTriangles;
+    return Error{text.str()};
+  }
   if (triangleIndices.size() % 3 != 0) {
     std::ostringstream text;
     text << "Bvh: " << triangleIndices.size()
@@ -100,7 +108,7 @@ Result<Bvh> Bvh::build(std::span<const Index> triangleIndices, std::span<const V
   for (Index t = 0; t < triangleCount; ++t) tree.m_triangleOrder[t] = t;
   std::vector<BuildNode> buildNodes;
   buildNodes.reserve(2 * triangleCount);
-  buildRecursive(buildNodes, tree.m_triangleOrder, centroids, 0, triangleCount);
+  buildRecursive(buildNodes, tree.m_triangleOrder, centroids, 0, triangleCount, maxLeafTriangles);
 
   // Renumber breadth-first: the children of the nodes of one level are appended, in order, to
   // the next level, so siblings are adjacent and every level is one contiguous range.

@@ -10,17 +10,72 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <optional>
 #include <sstream>
 #include <utility>
 
 namespace weft {
 namespace {
 
+// Triangles per leaf of the collider's tree: a point query prunes by box, and small boxes prune
+// most (the cloth's self query wants large leaves instead, Bvh::kMaxLeafTriangles).
+constexpr Index kLeafTriangles = 4;
+
 std::string describeTriangle(Index t, Index a, Index b, Index c) {
   std::ostringstream text;
   text << "TriangleMeshShape: triangle " << t << " (vertices " << a << ", " << b << ", " << c
        << ")";
   return text.str();
+}
+
+// |p − closest point of triangle (a, b, c)|²: the Voronoi-region walk of closestPointOnTriangle
+// without the square root and the result record, for the many triangles a search rejects. The
+// winner is measured again with closestPointOnTriangle for its exact features.
+Real squaredDistanceToTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  const Vec3 ap = p - a;
+  const Real d1 = ab.dot(ap);
+  const Real d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
+  const Vec3 bp = p - b;
+  const Real d3 = ab.dot(bp);
+  const Real d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
+  const Real vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - (d1 / (d1 - d3)) * ab).squaredNorm();
+  const Vec3 cp = p - c;
+  const Real d5 = ab.dot(cp);
+  const Real d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
+  const Real vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - (d2 / (d2 - d6)) * ac).squaredNorm();
+  const Real va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
+    return (bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)).squaredNorm();
+  }
+  const Real inverse = 1 / (va + vb + vc);
+  return (ap - (vb * inverse) * ab - (vc * inverse) * ac).squaredNorm();
+}
+
+// True when segment a → a + travel meets box (slab test; a zero component of travel is a slab
+// the segment is either in or out of).
+bool segmentMeetsBox(const Vec3& a, const Vec3& travel, const Aabb& box) {
+  Real enter = 0, leave = 1;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (travel[axis] == 0) {
+      if (a[axis] < box.min[axis] || a[axis] > box.max[axis]) return false;
+      continue;
+    }
+    const Real inverse = 1 / travel[axis];
+    Real near = (box.min[axis] - a[axis]) * inverse;
+    Real far = (box.max[axis] - a[axis]) * inverse;
+    if (near > far) std::swap(near, far);
+    enter = std::max(enter, near);
+    leave = std::min(leave, far);
+    if (enter > leave) return false;
+  }
+  return true;
 }
 
 Real cornerAngle(const Vec3& corner, const Vec3& next, const Vec3& previous) {
@@ -83,18 +138,20 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
   auto geometry = std::make_shared<Geometry>();
   geometry->vertices.assign(localVertices.begin(), localVertices.end());
   geometry->indices.assign(indices.begin(), indices.end());
-  Result<Bvh> tree = Bvh::build(geometry->indices, geometry->vertices);
+  Result<Bvh> tree = Bvh::build(geometry->indices, geometry->vertices, kLeafTriangles);
   if (!tree) return tree.error();
   geometry->bvh = std::move(tree).value();
 
   // Face normals, angle-weighted vertex normals.
   const auto& x = geometry->vertices;
   geometry->faceNormals.resize(triangleCount);
+  geometry->corners.resize(3 * std::size_t(triangleCount));
   geometry->vertexNormals.assign(x.size(), Vec3::Zero());
   for (Index t = 0; t < triangleCount; ++t) {
     const Index corner[3] = {indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]};
     const Vec3 normal = (x[corner[1]] - x[corner[0]]).cross(x[corner[2]] - x[corner[0]]).normalized();
     geometry->faceNormals[t] = normal;
+    for (int k = 0; k < 3; ++k) geometry->corners[3 * t + k] = x[corner[k]];
     for (int k = 0; k < 3; ++k) {
       const Real angle = cornerAngle(x[corner[k]], x[corner[(k + 1) % 3]], x[corner[(k + 2) % 3]]);
       geometry->vertexNormals[corner[k]] += angle * normal;
@@ -116,6 +173,7 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
   }
   std::sort(edgeSlots.begin(), edgeSlots.end());
   geometry->edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
+  geometry->closed = true;
   for (std::size_t begin = 0; begin < edgeSlots.size();) {
     std::size_t end = begin;
     Vec3 sum = Vec3::Zero();
@@ -123,6 +181,8 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
       sum += geometry->faceNormals[edgeSlots[end].second / 3];
       ++end;
     }
+    // Closed: every edge has exactly two triangles (a border edge has one, a fin three or more).
+    if (end - begin != 2) geometry->closed = false;
     if (sum.squaredNorm() > 0) sum.normalize();
     for (std::size_t i = begin; i < end; ++i) geometry->edgeNormals[edgeSlots[i].second] = sum;
     begin = end;
@@ -132,9 +192,8 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
 }
 
 void TriangleMeshShape::worldVertices(std::span<Vec3> vertices) const {
-  const std::vector<Vec3>& local = m_geometry->vertices;
-  for (std::size_t v = 0; v < local.size() && v < vertices.size(); ++v) {
-    vertices[v] = m_motion.pose.toWorld(local[v]);
+  for (std::size_t v = 0; v < m_geometry->vertices.size() && v < vertices.size(); ++v) {
+    vertices[v] = m_motion.pose.toWorld(m_geometry->vertices[v]);
   }
 }
 
@@ -145,15 +204,11 @@ Status TriangleMeshShape::setMotion(const RigidMotion& motion) {
   return Status::success();
 }
 
-ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
-  const Vec3 local = m_motion.pose.toLocal(point);
-  const Geometry& mesh = *m_geometry;
-  const std::vector<Bvh::Node>& nodes = mesh.bvh.nodes();
-
+Index TriangleMeshShape::closestTriangle(const Vec3& local, Real maxSquared) const {
+  const std::vector<Bvh::Node>& nodes = m_geometry->bvh.nodes();
   // Best-first descent with a fixed stack (one pending sibling per level).
-  Real bestSquared = std::numeric_limits<Real>::infinity();
+  Real bestSquared = maxSquared;
   Index bestTriangle = kInvalidIndex;
-  TriangleClosestPoint best;
   Index stack[64];
   int top = 0;
   stack[top++] = 0;
@@ -161,15 +216,15 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
     const Bvh::Node& node = nodes[stack[--top]];
     if (node.bounds.squaredDistanceTo(local) >= bestSquared) continue;
     if (node.isLeaf()) {
-      for (Index t : mesh.bvh.leafTriangles(node)) {
-        const TriangleClosestPoint candidate = closestPointOnTriangle(
-            local, mesh.vertices[mesh.indices[3 * t]], mesh.vertices[mesh.indices[3 * t + 1]],
-            mesh.vertices[mesh.indices[3 * t + 2]]);
-        const Real squared = candidate.distance * candidate.distance;
+      for (Index t : m_geometry->bvh.leafTriangles(node)) {
+        const Vec3* corner = &m_geometry->corners[3 * t];
+        // The distance to the triangle's plane bounds the distance to the triangle from below.
+        const Real plane = m_geometry->faceNormals[t].dot(local - corner[0]);
+        if (plane * plane >= bestSquared) continue;
+        const Real squared = squaredDistanceToTriangle(local, corner[0], corner[1], corner[2]);
         // Strictly closer only: among equal distances the first one found (a fixed order) wins.
         if (squared < bestSquared) {
           bestSquared = squared;
-          best = candidate;
           bestTriangle = t;
         }
       }
@@ -186,24 +241,77 @@ ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
       }
     }
   }
+  return bestTriangle;
+}
+
+ShapeContact TriangleMeshShape::queryPoint(const Vec3& point) const {
+  const Vec3 local = m_motion.pose.toLocal(point);
+  return contactWith(local, closestTriangle(local, std::numeric_limits<Real>::infinity()));
+}
+
+std::optional<ShapeContact> TriangleMeshShape::queryPointWithin(const Vec3& point,
+                                                                Real maxDistance) const {
+  const Vec3 local = m_motion.pose.toLocal(point);
+  const Index triangle = closestTriangle(local, maxDistance * maxDistance);
+  if (triangle == kInvalidIndex) return std::nullopt;
+  const ShapeContact contact = contactWith(local, triangle);
+  if (!(std::abs(contact.distance) < maxDistance)) return std::nullopt;
+  return contact;
+}
+
+ShapeContact TriangleMeshShape::contactWith(const Vec3& local, Index triangle) const {
+  const Vec3* corner = &m_geometry->corners[3 * triangle];
+  const TriangleClosestPoint best = closestPointOnTriangle(local, corner[0], corner[1], corner[2]);
+  const Vec3 offset = local - best.point;
+  if (!m_geometry->closed) {
+    // A two-sided shell: the unsigned distance, the normal towards the side the point is on.
+    const Vec3 normal = best.distance > 0 ? Vec3(offset / best.distance) : m_geometry->faceNormals[triangle];
+    return detail::worldContact(m_motion, best.distance, normal, best.point);
+  }
 
   // Pseudo-normal of the closest feature: vertex (one weight is 1), edge (one weight is 0), face.
   const Vec3& w = best.barycentric;
-  Vec3 pseudoNormal = mesh.faceNormals[bestTriangle];
+  Vec3 pseudoNormal = m_geometry->faceNormals[triangle];
   for (Index k = 0; k < 3; ++k) {
     if (w[k] == 1) {
-      pseudoNormal = mesh.vertexNormals[mesh.indices[3 * bestTriangle + k]];
+      pseudoNormal = m_geometry->vertexNormals[m_geometry->indices[3 * triangle + k]];
       break;
     }
     if (w[k] == 0) {
       // The edge opposite corner k runs from corner k+1 to corner k+2: edge slot (k + 1) % 3.
-      pseudoNormal = mesh.edgeNormals[3 * bestTriangle + (k + 1) % 3];
+      pseudoNormal = m_geometry->edgeNormals[3 * triangle + (k + 1) % 3];
     }
   }
-  const Vec3 offset = local - best.point;
   const Real side = offset.dot(pseudoNormal) < 0 ? -1.0 : 1.0;
   const Vec3 normal = best.distance > 0 ? Vec3(side * offset / best.distance) : pseudoNormal;
   return detail::worldContact(m_motion, side * best.distance, normal, best.point);
+}
+
+std::optional<Real> TriangleMeshShape::firstCrossing(const Vec3& start, const Vec3& end) const {
+  const Vec3 a = m_motion.pose.toLocal(start);
+  const Vec3 travel = m_motion.pose.toLocal(end) - a;
+  const std::vector<Bvh::Node>& nodes = m_geometry->bvh.nodes();
+  Real first = std::numeric_limits<Real>::infinity();
+  Index stack[64];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Bvh::Node& node = nodes[stack[--top]];
+    if (!segmentMeetsBox(a, travel, node.bounds)) continue;
+    if (!node.isLeaf()) {
+      stack[top++] = node.first;
+      stack[top++] = node.first + 1;
+      continue;
+    }
+    for (Index t : m_geometry->bvh.leafTriangles(node)) {
+      const Vec3* corner = &m_geometry->corners[3 * t];
+      const SegmentTriangleClosestPoints hit = closestPointsOnSegmentAndTriangle(
+          a, a + travel, corner[0], corner[1], corner[2]);
+      if (hit.distance == 0) first = std::min(first, hit.segmentParameter);
+    }
+  }
+  if (first > 1) return std::nullopt;
+  return first;
 }
 
 Aabb TriangleMeshShape::bounds() const {

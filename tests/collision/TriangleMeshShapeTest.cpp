@@ -1,11 +1,14 @@
 // Triangle-mesh collider: a closed cube mesh must agree with the analytic Box everywhere (sign
-// from pseudo-normals at faces, edges and corners); validation; kinematic pose.
+// from pseudo-normals at faces, edges and corners); an open mesh (a one-quad table top) is a
+// two-sided shell; the bounded query and the segment crossing; validation; kinematic pose.
 #include <weft/collision/Box.h>
 #include <weft/collision/TriangleMeshShape.h>
 
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <optional>
 #include <random>
 
 namespace weft {
@@ -66,6 +69,93 @@ TEST(TriangleMeshShape, ClosedCubeMatchesTheAnalyticBox) {
   EXPECT_GT(mesh->queryPoint(nearCorner).distance, 0);
   const Vec3 justInsideCorner = motion.pose.toWorld(half - Vec3(1e-3, 2e-3, 3e-3));
   EXPECT_LT(mesh->queryPoint(justInsideCorner).distance, 0);
+}
+
+// A horizontal square table top [−h, h] × [−h, h] at height y, two triangles facing up.
+CubeMesh makeTableTop(Real h, Real y) {
+  CubeMesh top;
+  top.vertices = {Vec3(-h, y, h), Vec3(h, y, h), Vec3(h, y, -h), Vec3(-h, y, -h)};
+  top.indices = {0, 1, 2, 0, 2, 3};
+  return top;
+}
+
+TEST(TriangleMeshShape, ClosedAndOpenMeshesAreTold) {
+  const CubeMesh cube = makeCube(Vec3::Ones());
+  EXPECT_TRUE(TriangleMeshShape::create(cube.vertices, cube.indices).value().isClosed());
+  const CubeMesh top = makeTableTop(0.5, 0);
+  EXPECT_FALSE(TriangleMeshShape::create(top.vertices, top.indices).value().isClosed());
+  // A cube without its top face: every edge of the rim has one triangle.
+  std::vector<Index> openBox(cube.indices.begin(), cube.indices.end());
+  openBox.erase(openBox.begin() + 18, openBox.begin() + 24);  // the +y face
+  EXPECT_FALSE(TriangleMeshShape::create(cube.vertices, openBox).value().isClosed());
+  const std::vector<Vec3> one = {Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, -1)};
+  EXPECT_FALSE(TriangleMeshShape::create(one, std::vector<Index>{0, 1, 2}).value().isClosed());
+}
+
+TEST(TriangleMeshShape, AnOpenMeshIsATwoSidedShell) {
+  RigidMotion motion;
+  motion.pose.position = Vec3(0.2, 0.75, -0.1);
+  const CubeMesh top = makeTableTop(0.5, 0);
+  const TriangleMeshShape mesh = TriangleMeshShape::create(top.vertices, top.indices, motion).value();
+  // Below the top, anywhere in its shadow: the unsigned distance, the normal pointing down.
+  for (const Real below : {1e-4, 3e-3, 0.05, 0.4, 3.0}) {
+    for (const Vec3& across : {Vec3(0, 0, 0), Vec3(0.3, 0, -0.2), Vec3(-0.49, 0, 0.49)}) {
+      const Vec3 point = motion.pose.position + across - Vec3(0, below, 0);
+      const ShapeContact contact = mesh.queryPoint(point);
+      EXPECT_NEAR(contact.distance, below, 1e-12) << "below " << below;
+      EXPECT_LT((contact.normal - Vec3(0, -1, 0)).norm(), 1e-12) << "below " << below;
+      EXPECT_LT((contact.point + below * contact.normal - point).norm(), 1e-12);
+      // The same above, the normal pointing up.
+      const ShapeContact above = mesh.queryPoint(point + Vec3(0, 2 * below, 0));
+      EXPECT_NEAR(above.distance, below, 1e-12);
+      EXPECT_LT((above.normal - Vec3(0, 1, 0)).norm(), 1e-12);
+    }
+  }
+  // Beside and below the edge: towards the point from the edge.
+  const ShapeContact beside = mesh.queryPoint(motion.pose.position + Vec3(0.8, -0.4, 0));
+  EXPECT_NEAR(beside.distance, 0.5, 1e-12);
+  EXPECT_LT((beside.normal - Vec3(0.6, -0.8, 0)).norm(), 1e-12);
+  // On the surface (exactly: the mesh at the identity pose): the face normal.
+  const TriangleMeshShape still = TriangleMeshShape::create(top.vertices, top.indices).value();
+  const ShapeContact on = still.queryPoint(Vec3(0.125, 0, 0.25));
+  EXPECT_EQ(on.distance, 0);
+  EXPECT_LT((on.normal - Vec3(0, 1, 0)).norm(), 1e-12);
+}
+
+TEST(TriangleMeshShape, TheBoundedQueryAgreesWithinItsRangeAndPrunesBeyond) {
+  const CubeMesh cube = makeCube(Vec3(0.5, 0.3, 0.2));
+  const TriangleMeshShape mesh = TriangleMeshShape::create(cube.vertices, cube.indices).value();
+  std::mt19937 random(9);
+  std::uniform_real_distribution<Real> coordinate(-1.5, 1.5);
+  int within = 0, beyond = 0;
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3 point(coordinate(random), coordinate(random), coordinate(random));
+    const ShapeContact exact = mesh.queryPoint(point);
+    const std::optional<ShapeContact> bounded = mesh.queryPointWithin(point, 0.4);
+    if (std::abs(exact.distance) < 0.4) {
+      ASSERT_TRUE(bounded.has_value()) << "trial " << trial;
+      EXPECT_EQ(bounded->distance, exact.distance);
+      EXPECT_EQ(bounded->normal, exact.normal);
+      EXPECT_EQ(bounded->point, exact.point);
+      ++within;
+    } else {
+      EXPECT_FALSE(bounded.has_value()) << "trial " << trial;
+      ++beyond;
+    }
+  }
+  EXPECT_GT(within, 100);
+  EXPECT_GT(beyond, 100);
+}
+
+TEST(TriangleMeshShape, TheFirstCrossingOfASegment) {
+  const CubeMesh top = makeTableTop(0.5, 0);
+  const TriangleMeshShape mesh = TriangleMeshShape::create(top.vertices, top.indices).value();
+  const std::optional<Real> down = mesh.firstCrossing(Vec3(0.1, 0.3, 0), Vec3(0.1, -0.1, 0));
+  ASSERT_TRUE(down.has_value());
+  EXPECT_NEAR(*down, 0.75, 1e-12);
+  EXPECT_FALSE(mesh.firstCrossing(Vec3(0.1, 0.3, 0), Vec3(0.1, 0.01, 0)).has_value());
+  EXPECT_FALSE(mesh.firstCrossing(Vec3(0.6, 0.3, 0), Vec3(0.6, -0.3, 0)).has_value());  // beside
+  EXPECT_FALSE(mesh.firstCrossing(Vec3(0.1, 0.3, 0), Vec3(0.1, 0.3, 0)).has_value());
 }
 
 TEST(TriangleMeshShape, SurfaceVelocityOfAKinematicMesh) {

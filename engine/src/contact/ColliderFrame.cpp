@@ -29,20 +29,33 @@ namespace {
 template <class PointAt>
 std::optional<PathContact> trace(const Shape& shape, const PointAt& pointAt, Real speed,
                                  const Vec3& a, const Vec3& b, Real thickness) {
-  const Real startDistance = queryPoint(shape, a).distance;
+  // A start farther from the surface than the path is long plus the thickness stays clear: the
+  // bounded query lets a mesh prune its search to that distance.
+  const std::optional<ShapeContact> start = queryPointWithin(shape, a, speed + thickness);
+  if (!start) return std::nullopt;  // far outside, or deep inside
+  const Real startDistance = start->distance;
   if (!(startDistance > 0)) return std::nullopt;  // starts inside: only a projection can help
   const Real level = startDistance >= thickness ? thickness : 0.5 * startDistance;
   if (!(speed > 0)) return std::nullopt;
   constexpr int kMaxSteps = 256;
   const Real minimumStep = 0.25 * thickness;
+  // A two-sided shell (an open mesh) has no beyond with a negative distance: a minimum step
+  // longer than the distance allows is tested for a crossing, and a path that crosses stops at
+  // the sample before it, on its own side.
+  const bool twoSided = isTwoSided(shape);
   Real s = 0;
   for (int step = 0; step < kMaxSteps; ++step) {
     const Vec3 point = s == 0 ? a : pointAt(s);
-    const ShapeContact contact = queryPoint(shape, point);
+    const ShapeContact contact = step == 0 ? *start : queryPoint(shape, point);
     if (contact.distance < level || step + 1 == kMaxSteps) {
       return PathContact{s, point, contact.normal, contact.distance, contact.normal};
     }
-    s += std::max(contact.distance - 0.5 * level, minimumStep) / speed;
+    const Real safeStep = contact.distance - 0.5 * level;
+    if (twoSided && safeStep < minimumStep &&
+        shellCrossing(shape, point, pointAt(std::min<Real>(1, s + minimumStep / speed)))) {
+      return PathContact{s, point, contact.normal, contact.distance, contact.normal};
+    }
+    s += std::max(safeStep, minimumStep) / speed;
     if (s > 1) {
       const ShapeContact end = queryPoint(shape, b);
       if (end.distance < level) return PathContact{1, b, end.normal, end.distance, end.normal};

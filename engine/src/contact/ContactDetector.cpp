@@ -109,10 +109,13 @@ void ContactDetector::constrain(const ContactSpace& space,
         if (const std::optional<PathContact> hit =
                 firstContactAlong(collider, space.startX[i], predicted, thickness)) {
           // A path that stays outside after it comes near is a graze: the end's own distance
-          // holds. Extrapolating the hit's tangent plane would overshoot on a curved body.
+          // holds. Extrapolating the hit's tangent plane would overshoot on a curved body. A
+          // two-sided shell (an open mesh) has no inside to show the middle in: there the path
+          // from the hit on is tested for a crossing instead.
           const bool graze =
               contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
-              queryPoint(collider.shape, 0.5 * (hit->point + predicted)).distance > 0;
+              queryPoint(collider.shape, 0.5 * (hit->point + predicted)).distance > 0 &&
+              !shellCrossing(collider.shape, hit->point, predicted);
           if (!graze) {
             direction = hit->impactNormal;
             depth = hit->distance + hit->normal.dot(predicted - hit->point);

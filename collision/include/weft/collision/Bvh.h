@@ -126,9 +126,12 @@ class Bvh {
 
   /// Builds the tree over `triangleIndices` (three per triangle) from the centroids at
   /// `positions` (usually the rest shape), then refits it to `positions` with zero thickness.
-  /// Errors: index count not a multiple of three, index out of range, non-finite position.
+  /// Leaves hold at most `maxLeafTriangles` (1 to kMaxLeafTriangles; point queries prune best
+  /// with small leaves, the self query runs fastest with large ones). Errors: index count not a
+  /// multiple of three, index out of range, non-finite position, leaf size out of range.
   static Result<Bvh> build(std::span<const Index> triangleIndices,
-                           std::span<const Vec3> positions);
+                           std::span<const Vec3> positions,
+                           Index maxLeafTriangles = kMaxLeafTriangles);
 
   /// Recomputes every box for static triangles at `positions`, inflated by `thickness` (m).
   /// `positions` must hold vertexCount() entries. Allocates nothing. With `tasks`, the loops run

@@ -11,6 +11,8 @@
 #include <weft/collision/Sphere.h>
 #include <weft/collision/TriangleMeshShape.h>
 
+#include <cmath>
+#include <optional>
 #include <variant>
 
 namespace weft {
@@ -22,6 +24,34 @@ using Shape = std::variant<Plane, Sphere, Capsule, Box, TriangleMeshShape>;
 /// point.
 inline ShapeContact queryPoint(const Shape& shape, const Vec3& point) {
   return std::visit([&](const auto& s) { return s.queryPoint(point); }, shape);
+}
+
+/// queryPoint() for a point nearer the surface of `shape` than `maxDistance` (m, on either side);
+/// none for a point at least that far from it. A mesh prunes its search to that distance, so a
+/// point far from it is cheap; the analytic shapes compute the distance and compare.
+inline std::optional<ShapeContact> queryPointWithin(const Shape& shape, const Vec3& point,
+                                                    Real maxDistance) {
+  if (const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&shape)) {
+    return mesh->queryPointWithin(point, maxDistance);
+  }
+  const ShapeContact contact = queryPoint(shape, point);
+  if (!(std::abs(contact.distance) < maxDistance)) return std::nullopt;
+  return contact;
+}
+
+/// True when `shape` is a two-sided shell (an open TriangleMeshShape), whose unsigned distance
+/// does not change sign where a path goes through it.
+inline bool isTwoSided(const Shape& shape) {
+  const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&shape);
+  return mesh && !mesh->isClosed();
+}
+
+/// For a two-sided shape (isTwoSided), the parameter s ∈ [0, 1] where the world segment
+/// a → b first meets its surface; none when it misses it, and always none for other shapes.
+inline std::optional<Real> shellCrossing(const Shape& shape, const Vec3& a, const Vec3& b) {
+  const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&shape);
+  if (!mesh || mesh->isClosed()) return std::nullopt;
+  return mesh->firstCrossing(a, b);
 }
 
 /// World box of `shape` (possibly unbounded for a plane).

@@ -2,21 +2,31 @@
 //
 // Design note
 // -----------
-// The mesh is stored in its body frame with an AABB tree over it (built once: the mesh is rigid,
-// so the tree never needs a refit). queryPoint() moves the query point into the body frame, finds
-// the closest triangle by a best-first descent of the tree (nearer child first, subtrees farther
-// than the best distance so far pruned), and signs the distance with the angle-weighted
-// pseudo-normal of the closest feature (Bærentzen & Aanæs 2005, "Signed distance computation
-// using the angle weighted pseudonormal"): the face normal inside a face, the sum of the two face
-// normals on an edge, the angle-weighted vertex normal at a vertex. For a closed, consistently
-// wound (counter-clockwise seen from outside) mesh this sign is exact: negative exactly inside.
-// Rejected: ray-parity inside tests (need a watertight mesh and break on rays through edges),
-// the face normal of the closest triangle alone (wrong sign near convex edges and vertices).
+// The mesh is stored in its body frame with an AABB tree over it (built once with small leaves:
+// the mesh is rigid, so the tree never needs a refit). queryPoint() moves the query point into
+// the body frame and finds the closest triangle by a best-first descent of the tree (nearer
+// child first, subtrees and triangles farther than the best distance so far pruned: a triangle
+// by the distance to its plane, a lower bound, before the exact point–triangle walk).
 //
-// Open meshes (a ground sheet, a cloak's collar) have no inside; the sign then says which side
-// of the surface the point lies on, at any distance, so a caller should only act on points near
-// the surface. For the cloth–mesh broad phase, build a Bvh over worldVertices() and indices()
-// and refit it every frame with the previous and current world vertices.
+// Closed meshes (every edge shared by exactly two triangles) sign the distance with the
+// angle-weighted pseudo-normal of the closest feature (Bærentzen & Aanæs 2005, "Signed distance
+// computation using the angle weighted pseudonormal"): the face normal inside a face, the sum of
+// the two face normals on an edge, the angle-weighted vertex normal at a vertex. For a closed,
+// consistently wound (counter-clockwise seen from outside) mesh this sign is exact: negative
+// exactly inside. Rejected: ray-parity inside tests (need a watertight mesh and break on rays
+// through edges), the face normal of the closest triangle alone (wrong sign near convex edges
+// and vertices).
+//
+// Open meshes (a table top of one quad, a flag, a leaf) have no inside: the pseudo-normal's side
+// reaches to infinity, and a point anywhere below a one-quad table top would be "inside" and be
+// pushed through to the top. An open mesh is therefore a two-sided shell: the distance is
+// unsigned and the normal points from the closest surface point to the query point, so a cloth
+// is kept at its thickness on whichever side it is. A path that crosses the shell within a step
+// is caught by the continuous tests of the caller (sphere tracing on the unsigned distance meets
+// the surface before it can pass it).
+//
+// For the cloth–mesh broad phase, build a Bvh over worldVertices() and indices() and refit it
+// every frame with the previous and current world vertices.
 #pragma once
 
 #include <weft/Math.h>
@@ -27,6 +37,7 @@
 #include <weft/collision/ShapeContact.h>
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -58,9 +69,23 @@ class TriangleMeshShape {
   const RigidMotion& motion() const { return m_motion; }
   /// Moves the mesh (validated like create()); unchanged on error.
   Status setMotion(const RigidMotion& motion);
-  /// Signed distance (pseudo-normal sign, see the design note), closest point, outward normal
-  /// and surface velocity for a world point.
+  /// True when every edge belongs to exactly two triangles (decided at create()): the mesh
+  /// bounds a volume and queryPoint() signs its distance. False: an open, two-sided shell whose
+  /// distance is unsigned (see the design note).
+  bool isClosed() const { return m_geometry->closed; }
+  /// Distance, closest point, normal and surface velocity for a world point. Closed mesh: signed
+  /// distance (pseudo-normal sign, negative inside) and outward normal. Open mesh: unsigned
+  /// distance and the normal from the closest point towards `point` (the face normal for a point
+  /// on the surface).
   ShapeContact queryPoint(const Vec3& point) const;
+  /// queryPoint() for a point nearer the surface than `maxDistance` (m, on either side); none
+  /// for a point at least that far from it. The search prunes everything beyond maxDistance, so
+  /// a point far from the mesh costs a few box tests.
+  std::optional<ShapeContact> queryPointWithin(const Vec3& point, Real maxDistance) const;
+  /// The parameter s ∈ [0, 1] of the first point where the world segment start → end meets a
+  /// triangle (the mesh at its current pose); none when it misses them all. For an open mesh,
+  /// whose unsigned distance cannot show that a path went through it.
+  std::optional<Real> firstCrossing(const Vec3& start, const Vec3& end) const;
   /// World box (the rotated body-frame box: conservative).
   Aabb bounds() const;
 
@@ -75,9 +100,17 @@ class TriangleMeshShape {
     std::vector<Vec3> faceNormals;    // per triangle, unit
     std::vector<Vec3> edgeNormals;    // per triangle corner k: edge (k, k+1), unit
     std::vector<Vec3> vertexNormals;  // per vertex, angle-weighted, unit
+    std::vector<Vec3> corners;        // per triangle, its three vertices
+    bool closed = false;              // every edge has exactly two triangles
   };
   std::shared_ptr<const Geometry> m_geometry;
   RigidMotion m_motion;
+
+  // The triangle closest to a body-frame point (the first found among equally close ones), or
+  // kInvalidIndex when none is nearer than sqrt(maxSquared).
+  Index closestTriangle(const Vec3& local, Real maxSquared) const;
+  // The contact of a body-frame point whose closest triangle is `triangle`.
+  ShapeContact contactWith(const Vec3& local, Index triangle) const;
 };
 
 }  // namespace weft
