@@ -1,6 +1,8 @@
 // Point–triangle and segment–segment closest points. See Proximity.h for the design note.
 #include <weft/collision/Proximity.h>
 
+#include "TriangleRegions.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -60,44 +62,9 @@ TriangleClosestPoint closestPointOnTriangle(const Vec3& p, const Vec3& a, const 
     return closestPointOnDegenerateTriangle(p, a, b, c);
   }
 
-  // Vertex region a.
-  const Vec3 ap = p - a;
-  const Real d1 = ab.dot(ap);
-  const Real d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return makeResult(p, 1, 0, 0, a, b, c);
-  // Vertex region b.
-  const Vec3 bp = p - b;
-  const Real d3 = ab.dot(bp);
-  const Real d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return makeResult(p, 0, 1, 0, a, b, c);
-  // Edge region ab.
-  const Real vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-    const Real s = d1 / (d1 - d3);
-    return makeResult(p, 1 - s, s, 0, a, b, c);
-  }
-  // Vertex region c.
-  const Vec3 cp = p - c;
-  const Real d5 = ab.dot(cp);
-  const Real d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return makeResult(p, 0, 0, 1, a, b, c);
-  // Edge region ac.
-  const Real vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-    const Real s = d2 / (d2 - d6);
-    return makeResult(p, 1 - s, 0, s, a, b, c);
-  }
-  // Edge region bc.
-  const Real va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    const Real s = (d4 - d3) / ((d4 - d3) + (d5 - d6));
-    return makeResult(p, 0, 1 - s, s, a, b, c);
-  }
-  // Face region: va, vb, vc are the (scaled) barycentric weights.
-  const Real inverse = 1 / (va + vb + vc);
-  const Real wb = vb * inverse;
-  const Real wc = vc * inverse;
-  return makeResult(p, 1 - wb - wc, wb, wc, a, b, c);
+  return detail::closestTriangleRegion(p, a, b, c, [&](Real wa, Real wb, Real wc) {
+    return makeResult(p, wa, wb, wc, a, b, c);
+  });
 }
 
 SegmentClosestPoints closestPointsOnSegments(const Vec3& p0, const Vec3& p1, const Vec3& q0,

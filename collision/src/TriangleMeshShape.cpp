@@ -5,6 +5,7 @@
 #include <weft/collision/Proximity.h>
 
 #include "ShapeSupport.h"
+#include "TriangleRegions.h"
 
 #include <algorithm>
 #include <cmath>
@@ -28,34 +29,13 @@ std::string describeTriangle(Index t, Index a, Index b, Index c) {
   return text.str();
 }
 
-// |p − closest point of triangle (a, b, c)|²: the Voronoi-region walk of closestPointOnTriangle
-// without the square root and the result record, for the many triangles a search rejects. The
-// winner is measured again with closestPointOnTriangle for its exact features.
+// |p − closest point of triangle (a, b, c)|²: closestPointOnTriangle's region walk without the
+// square root and the result record, for the many triangles a search rejects. The winner is
+// measured again with closestPointOnTriangle for its exact features.
 Real squaredDistanceToTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const Vec3 ab = b - a;
-  const Vec3 ac = c - a;
-  const Vec3 ap = p - a;
-  const Real d1 = ab.dot(ap);
-  const Real d2 = ac.dot(ap);
-  if (d1 <= 0 && d2 <= 0) return ap.squaredNorm();
-  const Vec3 bp = p - b;
-  const Real d3 = ab.dot(bp);
-  const Real d4 = ac.dot(bp);
-  if (d3 >= 0 && d4 <= d3) return bp.squaredNorm();
-  const Real vc = d1 * d4 - d3 * d2;
-  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (ap - (d1 / (d1 - d3)) * ab).squaredNorm();
-  const Vec3 cp = p - c;
-  const Real d5 = ab.dot(cp);
-  const Real d6 = ac.dot(cp);
-  if (d6 >= 0 && d5 <= d6) return cp.squaredNorm();
-  const Real vb = d5 * d2 - d1 * d6;
-  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (ap - (d2 / (d2 - d6)) * ac).squaredNorm();
-  const Real va = d3 * d6 - d5 * d4;
-  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-    return (bp - ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b)).squaredNorm();
-  }
-  const Real inverse = 1 / (va + vb + vc);
-  return (ap - (vb * inverse) * ab - (vc * inverse) * ac).squaredNorm();
+  return detail::closestTriangleRegion(p, a, b, c, [&](Real wa, Real wb, Real wc) {
+    return (p - (wa * a + wb * b + wc * c)).squaredNorm();
+  });
 }
 
 // True when segment a → a + travel meets box (slab test; a zero component of travel is a slab
