@@ -77,13 +77,15 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   m_inverseMasses.resize(n);
   const std::vector<Real>& mass = m_forces.masses();
   for (Index i = 0; i < n; ++i) m_inverseMasses[i] = m_pinnedMask[i] ? 0 : 1 / mass[i];
-  // Self-contacts in an implicit solve: k is the stretch stiffness (SelfContactPenalty.h).
+  // Self-contacts in an implicit solve, when asked: k = selfContactStiffness × the stretch
+  // stiffness, N/m (SelfContactPenalty.h).
   if (settings.solver.integrator == IntegratorKind::ImplicitEuler ||
       settings.solver.integrator == IntegratorKind::Bdf2) {
-    m_selfContactStiffness = settings.forceModel == ForceModel::MassSpring
-                                 ? settings.springs.structuralStiffness
-                                 : std::max(settings.material.warpStretchStiffness,
-                                            settings.material.weftStretchStiffness);
+    const Real stretch = settings.forceModel == ForceModel::MassSpring
+                             ? settings.springs.structuralStiffness
+                             : std::max(settings.material.warpStretchStiffness,
+                                        settings.material.weftStretchStiffness);
+    m_selfContactStiffness = settings.solver.selfContactStiffness * stretch;
   }
   estimateStiffestMode();
 }

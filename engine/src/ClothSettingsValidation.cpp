@@ -152,6 +152,8 @@ std::string validateClothSettings(const ClothModel* model, const ClothSettings& 
            checkNonNegative("springs.flexionDamping", s.flexionDamping, "N·s/m"),
            checkPositive("solver.maxImplicitStep", solver.maxImplicitStep, "s"),
            checkPositive("solver.cgTolerance", solver.cgTolerance, ""),
+           checkNonNegative("solver.selfContactStiffness", solver.selfContactStiffness,
+                            "multiples of the stretch stiffness; 0 = off"),
            checkNonNegative("solver.maxPinTravelPerSubstep", solver.maxPinTravelPerSubstep,
                             "mean edge lengths (0 = no limit)"),
            checkNonNegative("solver.pinTeleportDistance", solver.pinTeleportDistance,

@@ -405,14 +405,11 @@ void readSprings(Reader& reader, const Json& object, const std::string& path, Ma
 
 void readSolver(Reader& reader, const Json& object, const std::string& path, SolverSettings& s) {
   if (!reader.expectObject(object, path, "solver settings")) return;
-  reader.removedKey(object, path, "selfContactStiffness",
-                    "self-contacts are constraints of the contact projection in every substep; "
-                    "delete the key");
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
                     "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "tightCgTolerance",
                     "tightSelfContactDensity", "tightPinTravel", "cgTolerance", "cgStopping",
-                    "cgMaxIterations", "warmStart"});
+                    "cgMaxIterations", "warmStart", "selfContactStiffness"});
   std::string name;
   if (reader.readString(object, path, "integrator", name) && Reader::member(object, "integrator")) {
     const std::optional<IntegratorKind> kind = integratorFromName(name);
@@ -436,6 +433,8 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
                   "cloth sizes");
   reader.readReal(object, path, "pinTeleportAngle", s.pinTeleportAngle, Range::NonNegative, "rad");
+  reader.readReal(object, path, "selfContactStiffness", s.selfContactStiffness, Range::NonNegative,
+                  "multiples of the stretch stiffness, 0 = off");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
   reader.readReal(object, path, "tightCgTolerance", s.tightCgTolerance, Range::NonNegative,
                   "relative residual, 0 = off");

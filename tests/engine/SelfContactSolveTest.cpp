@@ -1,6 +1,7 @@
-// Crumpled piles and folds held by self-contact: the corner crumple of CollisionScenesTest settles
-// at a tight solver tolerance, a napkin folded by its pins stays untangled whatever the solve's
-// form, and the pile is bitwise identical on one and two threads.
+// Self-contacts inside the implicit solve (SolverSettings::selfContactStiffness): the corner
+// crumple of CollisionScenesTest settles at a tight solver tolerance, a napkin folded by its pins
+// stays untangled whatever the solve's form, and the pile is bitwise identical on one and two
+// threads.
 #include "ContactTestSupport.h"
 
 #include <weft/collision/Plane.h>
@@ -28,7 +29,7 @@ constexpr Real kFrame = 1.0 / 60.0;
 // The corner crumple of CollisionScenesTest at cgTolerance 1e-4 (relative residual), over eight
 // drop heights (27 to 31.7 cm; the pile is a chaotic outcome of the drop). Without self-contacts
 // in the solve such piles keep stirring (tests/README.md, "The crumpled piles"); with them
-// (contact/SelfContactPenalty.h) each draw must settle: kinetic energy below 1e-5 J after 400
+// (stiffness 1, contact/SelfContactPenalty.h) each draw must settle: kinetic energy below 1e-5 J after 400
 // frames. Every draw also asserts no intersecting pair and no vertex in the floor after every
 // frame, that the cloth lay on itself and came down, the strain condition (cotton: the limit +
 // 0.01), and no rollback or retry.
@@ -43,6 +44,7 @@ TEST_P(SelfContactSolvePile, ACrumpledPileSettlesAtATightSolverTolerance) {
   ClothSettings settings = cornerDrop(*model, lift);
   settings.material = cottonFabric();
   settings.solver.cgTolerance = 1e-4;
+  settings.solver.selfContactStiffness = 1;
   const ClothId cloth = world.createCloth(model, settings).value();
   IntersectionCounter counter(world, {cloth});
   test::StepHealth health;
@@ -93,6 +95,7 @@ TEST(SelfContactSolve, ANapkinFoldedByItsPinsStaysUntangledWithPinsRemovedKeptOr
     ClothSettings settings;
     settings.material = cottonFabric();  // so that the strain condition applies
     for (Index c = 0; c < kSide; ++c) settings.pinnedVertices.push_back(c);
+    settings.solver.selfContactStiffness = 1;
     settings.solver.removePinnedVertices = variant.removePins;
     settings.solver.newtonIterations = variant.newtonIterations;
     const ClothId cloth = world.createCloth(horizontalSquare(kSide, kSize, 0.01), settings).value();
@@ -151,6 +154,7 @@ TEST(SelfContactSolve, ThePileIsBitwiseIdenticalOnOneAndTwoThreads) {
     World world(worldSettings);
     (void)world.addCollider(Plane::create(Vec3(0, 1, 0)).value()).value();
     ClothSettings settings = cornerDrop(*model, 0.3);
+    settings.solver.selfContactStiffness = 1;
     (void)world.createCloth(model, settings).value();
     Index selfContacts = 0;
     test::StepHealth health;

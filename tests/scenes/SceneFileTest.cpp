@@ -58,18 +58,24 @@ TEST(SceneFile, FaceContactsCanBeTurnedOffPerCloth) {
 }
 
 TEST(SceneFile, KeysOfRemovedSettingsSayWhatReplacedThem) {
-  // The rival contact pipelines' switches are gone: a file that still sets one is refused with a
+  // The rival contact pipeline's switch is gone: a file that still sets it is refused with a
   // message that says why and what to do.
   Result<SceneDescription> joint = loadSceneText(
       R"({"version": 1, "cloths": [{"grid": {}, "jointContactProjection": true}]})");
   ASSERT_FALSE(joint.ok());
   EXPECT_THAT(joint.error().message, HasSubstr("/cloths/0/jointContactProjection"));
   EXPECT_THAT(joint.error().message, HasSubstr("no longer exists"));
-  Result<SceneDescription> penalty = loadSceneText(
-      R"({"version": 1, "cloths": [{"grid": {}, "solver": {"selfContactStiffness": 1}}]})");
-  ASSERT_FALSE(penalty.ok());
-  EXPECT_THAT(penalty.error().message, HasSubstr("/cloths/0/solver/selfContactStiffness"));
-  EXPECT_THAT(penalty.error().message, HasSubstr("delete the key"));
+}
+
+TEST(SceneFile, SelfContactsInTheSolveAreReadAndRangeChecked) {
+  Result<SceneDescription> on = loadSceneText(
+      R"({"version": 1, "cloths": [{"grid": {}, "solver": {"selfContactStiffness": 0.5}}]})");
+  ASSERT_TRUE(on.ok()) << on.error().message;
+  EXPECT_EQ(on->cloths[0].settings.solver.selfContactStiffness, 0.5);
+  Result<SceneDescription> negative = loadSceneText(
+      R"({"version": 1, "cloths": [{"grid": {}, "solver": {"selfContactStiffness": -1}}]})");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_THAT(negative.error().message, HasSubstr("/cloths/0/solver/selfContactStiffness"));
 }
 
 TEST(SceneFile, DefaultsAreTheDocumentedOnes) {

@@ -100,6 +100,10 @@ struct SolverSettings {
   /// Take pinned vertices out of the implicit system (their known velocity change moves to the
   /// right-hand side) instead of keeping them filtered in it; same motion. false is for checks.
   bool removePinnedVertices = true;
+  /// Self-contacts inside the implicit solve (implicit Euler, BDF2), as a multiple of the stretch
+  /// stiffness: settles crumpled piles, at about 2.5× the CG iterations in contact-heavy frames.
+  /// ≥ 0; 0 = off (default): the contact projection alone keeps the layers apart.
+  Real selfContactStiffness = 0;
 };
 
 }  // namespace weft
