@@ -32,9 +32,9 @@
 // that rests at the substep start takes it on its whole tangential displacement relative to the
 // body, so that it sticks without creeping h² a a substep; one that met the body within the
 // substep takes it on its velocity instead (its end is where its path slid on from the hit, not
-// x₀ + h v). Friction acts in the first sweep only: it holds what the solve moved, and the sweeps
-// after it enforce the strain limit and the separations, which friction may not resist (a cloth
-// pulled over a body at its limit slides on it).
+// x₀ + h v). Friction acts in every sweep, its accumulated correction bounded by that budget, so
+// the later sweeps' strain and separation corrections cannot undo what it holds, and a cloth
+// pulled over a body at its limit still slides once its budget is spent.
 //
 // After the iteration: collider contacts and pairs keep no relative normal velocity into each
 // other (inelastic), and the face points left resting on a core are returned as supports, which
