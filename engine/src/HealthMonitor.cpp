@@ -22,14 +22,18 @@ constexpr Real kQuietSpeed = 0.01;
 }  // namespace
 
 HealthFailure checkSubstepHealth(const ContactSpace& space) {
-  bool finite = true, slow = true;
-  for (const Vec3& x : space.x) finite = finite && x.allFinite();
+  bool finite = true, slow = true, inRange = true;
+  for (const Vec3& x : space.x) {
+    finite = finite && x.allFinite();
+    inRange = inRange && x.cwiseAbs().maxCoeff() <= kMaxSimulatedCoordinate;
+  }
   for (const Vec3& v : space.v) {
     finite = finite && v.allFinite();
     slow = slow && v.squaredNorm() < kDivergedSpeed * kDivergedSpeed;
   }
   if (!finite) return HealthFailure::NonFinite;
   if (!slow) return HealthFailure::Speed;
+  if (!inRange) return HealthFailure::OutOfRange;
   return HealthFailure::None;
 }
 

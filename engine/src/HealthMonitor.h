@@ -1,8 +1,10 @@
 // HealthMonitor: the checks that tell a diverging integration from motion, and the retry policy.
 //
-// After every substep the state must be finite and no vertex faster than 10⁴ m/s (a NaN spreads
-// through the whole mesh within one solve; a diverging explicit method passes any physical speed
-// within a few substeps). After every attempt at a frame, no edge may have grown past 100 times
+// After every substep the state must be finite, no vertex faster than 10⁴ m/s and none farther
+// than 10⁹ m from the origin (a NaN spreads through the whole mesh within one solve; a diverging
+// explicit method passes any physical speed within a few substeps; a frame of 10³⁰⁸ s carries a
+// slow cloth where doubles cannot tell its vertices apart, and every pair of its triangles would
+// be a contact to test). After every attempt at a frame, no edge may have grown past 100 times
 // its rest length (and longer than at the frame start), and the kinetic energy may not exceed 100
 // times what the frame could supply: what the cloth had, the cloth thrown at the fastest driver's
 // speed (pins, collider surfaces, wind), a fall through its own size, and the work of the

@@ -48,6 +48,7 @@ const char* describe(HealthFailure failure) {
     case HealthFailure::Speed: return "speed";
     case HealthFailure::Strain: return "strain";
     case HealthFailure::EnergyJump: return "energy-jump";
+    case HealthFailure::OutOfRange: return "out-of-range";
   }
   return "unknown";
 }

@@ -53,8 +53,9 @@ enum class HealthFailure : std::uint8_t {
   Speed,       ///< a vertex moved faster than kMaxSpeed (10⁴ m/s, InputLimits.h)
   Strain,      ///< an edge grew to more than 100× its rest length, longer than at the frame start
   EnergyJump,  ///< kinetic energy rose 100× above what the frame's own sources could supply
+  OutOfRange,  ///< a vertex went beyond kMaxSimulatedCoordinate (1e9 m, InputLimits.h)
 };
-/// "none", "non-finite", "speed", "strain" or "energy-jump".
+/// "none", "non-finite", "speed", "strain", "energy-jump" or "out-of-range".
 const char* describe(HealthFailure failure);
 
 /// Statistics of the last frame, summed over cloths and substeps (Box2D b2Profile in spirit).
