@@ -26,8 +26,15 @@ constexpr int kFollowTheLeaderSweeps = 1;
 // projection just put at the reach is at −1e-17).
 constexpr Real kTouching = 1e-9;
 
+// Below this fraction of the free weight sum, an edge held at both ends along itself is left to
+// the contacts (it cannot be shortened across the surfaces it rests on), and a pair whose movable
+// vertices carry less than this fraction of its Σ w_k² is left to the impact pass (they would
+// have to move by its shortfall / w_k: a point on a face whose pinned corners collapsed together
+// flew 10¹² m).
+constexpr Real kSmallestHeldWeight = 1e-3;
+
 // The inverse mass every movable vertex of a pair counts with (the pair's heaviest) and the sum
-// Σ w_k² W over its movable vertices; 0 when none can move.
+// Σ w_k² W over its movable vertices; 0 when none can move, or too little (kSmallestHeldWeight).
 std::pair<Real, Real> pairInverseMass(const Contact& contact, std::span<const Real> inverseMasses) {
   Real heaviest = std::numeric_limits<Real>::infinity();
   for (int k = 0; k < 4; ++k) {
@@ -35,10 +42,13 @@ std::pair<Real, Real> pairInverseMass(const Contact& contact, std::span<const Re
     if (w > 0 && contact.weights[k] != 0) heaviest = std::min(heaviest, w);
   }
   if (!std::isfinite(heaviest)) return {0, 0};
-  Real sum = 0;
+  Real sum = 0, whole = 0;
   for (int k = 0; k < 4; ++k) {
-    if (inverseMasses[contact.vertices[k]] > 0) sum += contact.weights[k] * contact.weights[k];
+    const Real square = contact.weights[k] * contact.weights[k];
+    whole += square;
+    if (inverseMasses[contact.vertices[k]] > 0) sum += square;
   }
+  if (!(sum >= kSmallestHeldWeight * whole)) return {0, 0};
   return {heaviest, sum * heaviest};
 }
 
@@ -48,10 +58,6 @@ Vec3 frictionCorrection(const Vec3& slip, const Vec3& applied, Real normal, Real
   const Vec3 free = slip - applied;
   return coulombFriction(free, normal, friction) - free;
 }
-
-// Below this fraction of the free weight sum, an edge held at both ends along itself is left to
-// the contacts (it cannot be shortened across the surfaces it rests on).
-constexpr Real kSmallestHeldWeight = 1e-3;
 
 // An edge's weight sum when its ends may move only across their contact normals (zero normal:
 // free): w (1 − (n·d)²) per end, d the edge's direction.

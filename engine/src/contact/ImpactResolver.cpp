@@ -29,6 +29,10 @@ constexpr TaskSystem::Index kGrainFeaturePairs = 128;
 constexpr Real kHeldReach = 1.5;
 // A held vertex counts as 1000× heavier in impulses, so the free side of a pair takes them.
 constexpr Real kHeldInverseMassScale = 1e-3;
+// Below this fraction of a pair's Σ w_k², its movable vertices cannot take an impulse: they would
+// have to move at Δu / w_k (a point on a face whose pinned corners collapsed together flew at
+// 10¹⁵ m/s). The impact zones, which move with the pins, take such a pair.
+constexpr Real kSmallestMovableWeight = 1e-3;
 
 Index findRoot(std::vector<Index>& parent, Index vertex) {
   while (parent[vertex] != vertex) {
@@ -202,6 +206,13 @@ void ImpactResolver::applyImpulse(const Impact& impact, Real targetNormalSpeed,
     effective += impact.weights[k] * impact.weights[k] * inverseMass[k];
   }
   if (effective <= 0) return;  // all four pinned
+  Real whole = 0, movable = 0;
+  for (int k = 0; k < 4; ++k) {
+    const Real square = impact.weights[k] * impact.weights[k];
+    whole += square;
+    if (space.inverseMass[impact.vertices[k]] > 0) movable += square;
+  }
+  if (!(movable >= kSmallestMovableWeight * whole)) return;
   // When the free side holds the pair point only with a small weight, taking all of the
   // relative change would throw that vertex at Δu / w: the true masses share it instead, and the
   // clamp afterwards puts back what reaches into a collider.
