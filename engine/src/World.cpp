@@ -31,6 +31,7 @@ std::string describe(StepStatus status) {
   add(StepStatus::InvalidInput, "invalid-input");
   add(StepStatus::RetriedWithSmallerStep, "retried-with-smaller-step");
   add(StepStatus::BudgetMissed, "budget-missed");
+  add(StepStatus::StrainLimitExceeded, "strain-limit-exceeded");
   return text;
 }
 
@@ -600,6 +601,18 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     }
   }
   const Index totalSubsteps = stats.substeps * (Index(m_steppedCloths.size()) - stats.sleepingCloths);
+  // The strain every cloth ends the frame with; a cloth past its limit + slack is reported,
+  // never passed off as ok.
+  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
+    if (!slot->cloth) continue;
+    const Real strain = slot->cloth->maxStrain();
+    stats.maxStrain = std::max(stats.maxStrain, strain);
+    const Real limit = slot->cloth->settings().material.strainLimit;
+    if (limit > 0 && std::isfinite(limit) && strain > limit + kStrainLimitSlack) {
+      ++stats.clothsOverStrainLimit;
+      stats.status |= StepStatus::StrainLimitExceeded;
+    }
+  }
   m_time += frameDt;
   stats.simulatedTime = m_time;
   stats.stepMs =

@@ -24,7 +24,9 @@
 // tell the two apart. Scenes whose set-up forces more strain than that (random or collapsed
 // starts, a teleport) measure it once the forcing is over; each says from when. Scenes that
 // cannot meet a condition say so and record the measured value instead of asserting it (see the
-// scene's comment), and nothing is tuned to pass.
+// scene's comment), and nothing is tuned to pass. Whatever a scene defers or marks, every frame
+// that ends past the limit + 1 % must carry StepStatus::StrainLimitExceeded: an unflagged excess
+// is a failure of every scene.
 #pragma once
 
 #include "engine/KnownEngineFailure.h"
@@ -49,8 +51,9 @@ namespace weft::stress {
 /// Strain (l / l_rest − 1) up to which the cotton material's numbers hold, and its
 /// ClothMaterial::strainLimit; see above.
 inline constexpr Real kCottonStrainLimit = 0.10;
-/// Absolute tolerance on the strain limit: "+ 1 %".
-inline constexpr Real kStrainTolerance = 0.01;
+/// Absolute tolerance on the strain limit: "+ 1 %", the engine's own slack before it reports
+/// StepStatus::StrainLimitExceeded.
+inline constexpr Real kStrainTolerance = kStrainLimitSlack;
 /// Largest fraction of frames allowed to hit the PCG's iteration cap.
 inline constexpr Real kMaxCapFraction = 0.01;
 
@@ -103,6 +106,9 @@ class StressMonitor {
     m_limiterLeftOver += m_world.stats().strainLimitEdgesOver;
     if (m_measureStrain) m_maxStrain = std::max(m_maxStrain, m_world.stats().maxStrain);
     m_peakStrain = std::max(m_peakStrain, m_world.stats().maxStrain);
+    if (!hasFlag(status, StepStatus::StrainLimitExceeded)) {
+      m_unflaggedStrain = std::max(m_unflaggedStrain, m_world.stats().maxStrain);
+    }
     bool finite = true;
     for (ClothId cloth : m_cloths) {
       for (const Vec3& x : m_world.positions(cloth).value()) finite = finite && x.allFinite();
@@ -197,6 +203,10 @@ class StressMonitor {
       EXPECT_TRUE(passed) << name << ": " << what;
     };
     EXPECT_EQ(m_nonFiniteFrames, 0) << name << ": frames with non-finite state";
+    // Honest status, asserted in every scene: a frame past the limit says so.
+    EXPECT_LE(m_unflaggedStrain, strainLimit + kStrainTolerance)
+        << name << ": a frame ended at strain " << m_unflaggedStrain
+        << " without StepStatus::StrainLimitExceeded";
     expectHealthy(name);
     EXPECT_GT(m_intersectionChecks, 0) << name;
     check(Condition::Intersections, m_maxIntersections == 0,
@@ -225,6 +235,7 @@ class StressMonitor {
   const char* m_retryReason = nullptr;
   int m_intersectionChecks = 0, m_firstIntersectingFrame = -1;
   Real m_maxStrain = 0, m_peakStrain = 0;
+  Real m_unflaggedStrain = 0;  // the largest strain of a frame not flagged StrainLimitExceeded
   Index m_maxIntersections = 0;
   std::uint64_t m_limiterLeftOver = 0;
 };

@@ -60,13 +60,14 @@ bool parseResolution(const std::string& text, int& width, int& height) {
 
 // Counts of each status flag over the run.
 struct StatusCounts {
-  unsigned unstable = 0, notConverged = 0, rolledBack = 0, retried = 0, invalid = 0;
+  unsigned unstable = 0, notConverged = 0, rolledBack = 0, retried = 0, invalid = 0, overLimit = 0;
   void add(StepStatus s) {
     unstable += hasFlag(s, StepStatus::Unstable);
     notConverged += hasFlag(s, StepStatus::SolverNotConverged);
     rolledBack += hasFlag(s, StepStatus::RolledBack);
     retried += hasFlag(s, StepStatus::RetriedWithSmallerStep);
     invalid += hasFlag(s, StepStatus::InvalidInput);
+    overLimit += hasFlag(s, StepStatus::StrainLimitExceeded);
   }
   std::string describe() const {
     std::string text;
@@ -78,6 +79,7 @@ struct StatusCounts {
     item(retried, "retried-with-smaller-step");
     item(rolledBack, "rolled-back");
     item(invalid, "invalid-input");
+    item(overLimit, "strain-limit-exceeded");
     return text.empty() ? "ok in every frame" : text;
   }
 };

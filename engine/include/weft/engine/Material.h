@@ -71,4 +71,9 @@ enum class ForceModel {
   MassSpring,    ///< structural, shear and flexion springs
 };
 
+/// Strain past ClothMaterial::strainLimit a frame may end with before the step reports
+/// StepStatus::StrainLimitExceeded: the limiter stops within 0.001, and the collision passes after
+/// it may stretch an edge a little more.
+inline constexpr Real kStrainLimitSlack = 0.01;
+
 }  // namespace weft

@@ -30,6 +30,11 @@ enum class StepStatus : std::uint32_t {
   /// the next frames' plans adapt (looser PCG tolerance, fewer iterations, fewer implicit
   /// substeps) within the limits of StepBudget. Raise the budget or those limits if it persists.
   BudgetMissed = 1u << 5,
+  /// A cloth ended the frame stretched past its ClothMaterial::strainLimit by more than
+  /// kStrainLimitSlack (see StepStats::clothsOverStrainLimit, maxStrain): its pins, contacts or
+  /// loads demand more than the limit, or the limiter ran out of iterations. Take more
+  /// substeps, move pins less far per frame, or raise the limit.
+  StrainLimitExceeded = 1u << 6,
 };
 
 constexpr StepStatus operator|(StepStatus a, StepStatus b) {
@@ -95,6 +100,9 @@ struct StepStats {
   /// with both ends pinned not counted). The impact pass after it may stretch edges a little
   /// more: maxStrain is what the frame ended with.
   Index strainLimitEdgesOver = 0;
+  /// Cloths that ended the frame past their strain limit + kStrainLimitSlack
+  /// (StepStatus::StrainLimitExceeded).
+  Index clothsOverStrainLimit = 0;
 
   // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
   Real budgetMs = 0;           ///< ms, the budget this frame was given (0 = none)

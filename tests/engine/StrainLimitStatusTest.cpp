@@ -1,0 +1,92 @@
+// The step's status says when a cloth ends a frame past its strain limit
+// (StepStatus::StrainLimitExceeded, StepStats::clothsOverStrainLimit): pins pulled apart beyond
+// what the limit allows are flagged in every frame, a sheet hanging within its limit never is,
+// and a cloth without a limit has none to exceed.
+#include <weft/engine/FabricPresets.h>
+#include <weft/engine/World.h>
+
+#include <gtest/gtest.h>
+
+#include <string>
+
+namespace weft {
+namespace {
+
+constexpr Real kFrame = 1.0 / 60.0;
+constexpr Index kColumns = 11, kRows = 5;
+constexpr Real kWidth = 0.5;  // m
+
+std::shared_ptr<const ClothModel> strip() {
+  GridSettings grid;
+  grid.columns = kColumns;
+  grid.rows = kRows;
+  grid.width = kWidth;
+  grid.height = 0.2;
+  return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+}
+
+// Both short sides of the strip pinned; `strainLimit` on cotton.
+ClothSettings pinnedAtBothEnds(Real strainLimit) {
+  ClothSettings settings;
+  settings.material = cottonFabric();
+  settings.material.strainLimit = strainLimit;
+  for (Index r = 0; r < kRows; ++r) {
+    settings.pinnedVertices.push_back(r * kColumns);
+    settings.pinnedVertices.push_back(r * kColumns + kColumns - 1);
+  }
+  return settings;
+}
+
+// Moves the pins of the strip's right side by `shift` along its length.
+void pullRightSide(World& world, ClothId cloth, const ClothSettings& settings, Real shift) {
+  std::vector<Vec3> targets = world.pinTargets(cloth).value();
+  for (std::size_t k = 0; k < targets.size(); ++k) {
+    if (settings.pinnedVertices[k] % kColumns == kColumns - 1) targets[k].x() += shift;
+  }
+  ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
+}
+
+TEST(StrainLimitStatus, PinsPulledApartPastTheLimitAreFlaggedInEveryFrame) {
+  // The pins 1.3 times the strip's length apart: every edge along it must stretch 0.3, three
+  // times the limit of 0.10.
+  World world;
+  const ClothSettings settings = pinnedAtBothEnds(0.1);
+  const ClothId cloth = world.createCloth(strip(), settings).value();
+  pullRightSide(world, cloth, settings, 0.3 * kWidth);
+  for (int frame = 0; frame < 30; ++frame) {
+    const StepStatus status = world.step(kFrame);
+    ASSERT_GT(world.stats().maxStrain, 0.1 + kStrainLimitSlack) << "frame " << frame;
+    EXPECT_TRUE(hasFlag(status, StepStatus::StrainLimitExceeded)) << "frame " << frame;
+    EXPECT_EQ(world.stats().clothsOverStrainLimit, 1u) << "frame " << frame;
+    EXPECT_NE(describe(status).find("strain-limit-exceeded"), std::string::npos);
+  }
+}
+
+TEST(StrainLimitStatus, ASheetWithinItsLimitIsNeverFlagged) {
+  // The same strip pulled by 5 %, within the limit: the limit is met, nothing is reported.
+  World world;
+  const ClothSettings settings = pinnedAtBothEnds(0.1);
+  const ClothId cloth = world.createCloth(strip(), settings).value();
+  pullRightSide(world, cloth, settings, 0.05 * kWidth);
+  for (int frame = 0; frame < 60; ++frame) {
+    const StepStatus status = world.step(kFrame);
+    EXPECT_LE(world.stats().maxStrain, 0.1 + kStrainLimitSlack) << "frame " << frame;
+    EXPECT_FALSE(hasFlag(status, StepStatus::StrainLimitExceeded)) << "frame " << frame;
+    EXPECT_EQ(world.stats().clothsOverStrainLimit, 0u) << "frame " << frame;
+  }
+}
+
+TEST(StrainLimitStatus, AClothWithoutALimitHasNoneToExceed) {
+  World world;
+  const ClothSettings settings = pinnedAtBothEnds(0);
+  const ClothId cloth = world.createCloth(strip(), settings).value();
+  pullRightSide(world, cloth, settings, 0.3 * kWidth);
+  for (int frame = 0; frame < 10; ++frame) {
+    const StepStatus status = world.step(kFrame);
+    EXPECT_GT(world.stats().maxStrain, 0.1 + kStrainLimitSlack) << "frame " << frame;
+    EXPECT_FALSE(hasFlag(status, StepStatus::StrainLimitExceeded)) << "frame " << frame;
+  }
+}
+
+}  // namespace
+}  // namespace weft
