@@ -2,10 +2,12 @@
 
 #include "Cloth.h"
 
+#include <weft/engine/Material.h>
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace weft {
 namespace {
@@ -148,7 +150,11 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
   if (unstable) stats.status |= StepStatus::Unstable;
 
   // Attempts: a frame that fails a health check is restored and retried with twice the
-  // substeps; after kMaxHealthRetries it is rolled back.
+  // substeps; after kMaxHealthRetries it is rolled back. A healthy frame that leaves a cloth past
+  // its strain limit is redone with twice the substeps too, within strainRetrySubsteps, when the
+  // substeps are automatic: the contacts of a squeeze move cloth several thicknesses a substep at
+  // 60 Hz, more than one projection can untangle from the limits.
+  const Index strainRetryCap = strainRetryLimit(cloths, plan);
   for (int attempt = 0;; ++attempt) {
     StepStats attemptStats;
     HealthFailure failure = runSubsteps(t, frameDt, substeps, attemptStats);
@@ -160,6 +166,15 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
         failure = checkFrameHealth(cloth, m_startStrain[c], m_startKinetic[c], cloth.maxStrain(),
                                    cloth.kineticEnergy(), m_frameStartMotions);
       }
+    }
+    if (failure == HealthFailure::None && substeps * 2 <= strainRetryCap && pastStrainLimit(cloths)) {
+      for (std::size_t c = 0; c < cloths.size(); ++c) {
+        if (m_stepping[c]) cloths[c]->restoreFrameStart();
+      }
+      ++stats.strainRetries;
+      substeps *= 2;
+      --attempt;  // not a health retry: the doubling itself bounds these
+      continue;
     }
     if (failure == HealthFailure::None) {
       addSubstepCounters(attemptStats, stats);  // the successful attempt's are the frame's
@@ -205,6 +220,29 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
     stats.potentialEnergy += cloth.lastPotential();
   }
+}
+
+Index SubstepPipeline::strainRetryLimit(std::span<Cloth* const> cloths, const StepPlan& plan) const {
+  if (plan.substeps > 0) return 0;
+  Index cap = std::numeric_limits<Index>::max();
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    if (!m_stepping[c]) continue;
+    const SolverSettings& solver = cloths[c]->settings().solver;
+    if (solver.substeps > 0) return 0;
+    cap = std::min({cap, solver.strainRetrySubsteps, solver.maxSubsteps});
+  }
+  return cap == std::numeric_limits<Index>::max() ? 0 : cap;
+}
+
+bool SubstepPipeline::pastStrainLimit(std::span<Cloth* const> cloths) const {
+  for (std::size_t c = 0; c < cloths.size(); ++c) {
+    if (!m_stepping[c]) continue;
+    const Real limit = cloths[c]->settings().material.strainLimit;
+    if (limit > 0 && std::isfinite(limit) && cloths[c]->maxStrain() > limit + kStrainLimitSlack) {
+      return true;
+    }
+  }
+  return false;
 }
 
 HealthFailure SubstepPipeline::runSubsteps(Real t, Real frameDt, Index substeps,

@@ -61,6 +61,12 @@ class SubstepPipeline {
  private:
   // The substeps of one attempt at the frame; the health check that failed, or None.
   HealthFailure runSubsteps(Real t, Real frameDt, Index substeps, StepStats& stats);
+  // The most substeps a frame past its strain limit is redone with: the smallest
+  // strainRetrySubsteps of the stepping cloths, 0 when any has fixed substeps or the plan fixes
+  // them (a budget's plan must replay as planned).
+  Index strainRetryLimit(std::span<Cloth* const> cloths, const StepPlan& plan) const;
+  // Whether a stepping cloth with a strain limit ends past it + kStrainLimitSlack.
+  bool pastStrainLimit(std::span<Cloth* const> cloths) const;
   // One substep (see the file comment).
   HealthFailure substep(Real t, Real h, Index index, StepStats& stats);
   void pose(Index index, Real h);

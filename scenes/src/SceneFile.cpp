@@ -407,6 +407,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   if (!reader.expectObject(object, path, "solver settings")) return;
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
+                    "strainRetrySubsteps",
                     "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "tightCgTolerance",
                     "tightSelfContactDensity", "tightPinTravel", "cgTolerance", "cgStopping",
                     "cgMaxIterations", "warmStart", "selfContactStiffness"});
@@ -428,6 +429,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readInteger(object, path, "substeps", s.substeps, 0, 100000);
   reader.readReal(object, path, "maxImplicitStep", s.maxImplicitStep, Range::Positive, "s");
   reader.readInteger(object, path, "maxSubsteps", s.maxSubsteps, 1, 1000000);
+  reader.readInteger(object, path, "strainRetrySubsteps", s.strainRetrySubsteps, 0, 1000000);
   reader.readReal(object, path, "maxPinTravelPerSubstep", s.maxPinTravelPerSubstep, Range::NonNegative,
                   "mean edge lengths");
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,

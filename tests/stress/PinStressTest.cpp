@@ -6,7 +6,7 @@
 //   10  the pins of a hanging cloth teleported 10 m sideways in one frame: carried with them (a
 //       teleport, SolverSettings::pinTeleportDistance), the cloth passes every condition from
 //       the jump on; with the teleport rule off (dragged at 600 m/s) it must recover too, over
-//       six draws of the jump, of which two are known engine failures.
+//       six draws of the jump, of which one is a known engine failure.
 #include "stress/StressSupport.h"
 
 #include <Eigen/Geometry>
@@ -171,7 +171,7 @@ TEST(StressPins, PinsTeleportedTenMetresCarryTheClothThere) {
 // The dragged jump over draws: the jump changed by 0 … 3 mm (what bench/weft-teleport-perturb
 // --pin-teleport-distance 0 runs, there with pin removal on and off too). Every draw asserts the
 // stress conditions (strain from 2 s after the jump on) and that the energy is back within 1 %
-// of m·g·height for good within 2 s. In the draws of 0.1 mm and 1 mm the crash into the stopped
+// of m·g·height for good within 2 s. In the draw of 0.1 mm the crash into the stopped
 // pins leaves a fold crushed in self-contact that a solve blind to the contacts keeps pushing
 // through the layer under it: the energy stays up. That condition is a known engine failure
 // there, with the figures measured (the stress conditions still asserted); with the contacts in
@@ -213,8 +213,7 @@ INSTANTIATE_TEST_SUITE_P(
         DraggedDraw{0, nullptr}, DraggedDraw{1e-6, nullptr}, DraggedDraw{1e-5, nullptr},
         DraggedDraw{1e-4, "a fold crushed by the crash keeps stirring: energy not back within 1 % "
                           "of m·g·height in 3 s (peak strain 0.14 in the crash)"},
-        DraggedDraw{1e-3, "a fold crushed by the crash keeps stirring: energy not back within 1 % "
-                          "of m·g·height in 3 s (peak strain 0.65 in the crash)"},
+        DraggedDraw{1e-3, nullptr},
         DraggedDraw{3e-3, nullptr}),
     [](const ::testing::TestParamInfo<DraggedDraw>& info) {
       const Real offset = info.param.jumpOffset;

@@ -103,6 +103,9 @@ struct StepStats {
   /// Cloths that ended the frame past their strain limit + kStrainLimitSlack
   /// (StepStatus::StrainLimitExceeded).
   Index clothsOverStrainLimit = 0;
+  /// Times the frame was redone with twice the substeps because a cloth ended it past its strain
+  /// limit (SolverSettings::strainRetrySubsteps); `substeps` is what the kept attempt took.
+  Index strainRetries = 0;
 
   // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
   Real budgetMs = 0;           ///< ms, the budget this frame was given (0 = none)
