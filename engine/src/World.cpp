@@ -57,6 +57,7 @@ struct World::ClothSlot {
   std::unique_ptr<Cloth> cloth;  // null when free
   std::uint32_t generation = 1;
   std::vector<ColliderAttachment> attachments;  // sorted by pinSlot
+  Real frameStrain = 0;  // the largest strain the cloth ended the last frame with
 };
 
 struct World::ColliderSlot {
@@ -696,6 +697,7 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     stats.solvedUnknowns += report.integrator.solvedUnknowns;
     stats.kineticEnergy += report.kineticEnergy;
     stats.maxStrain = std::max(stats.maxStrain, report.maxStrain);
+    slot->frameStrain = report.maxStrain;
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
   }
   std::size_t k = 0;
@@ -704,14 +706,11 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     (void)setMotion(*collider->shape, advanceMotion(m_colliderStartMotions[k++], frameDt));
   }
   collideCloths(frameDt, stats);
-  // The strain every cloth ends the frame with, after the cloth–cloth pass too; a cloth past its
-  // limit + slack is reported, never passed off as ok.
+  // A cloth that ends the frame past its limit + slack is reported, never passed off as ok.
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
     if (!slot->cloth) continue;
-    const Real strain = slot->cloth->maxStrain();
-    stats.maxStrain = std::max(stats.maxStrain, strain);
     const Real limit = slot->cloth->settings().material.strainLimit;
-    if (limit > 0 && std::isfinite(limit) && strain > limit + kStrainLimitSlack) {
+    if (limit > 0 && std::isfinite(limit) && slot->frameStrain > limit + kStrainLimitSlack) {
       ++stats.clothsOverStrainLimit;
       stats.status |= StepStatus::StrainLimitExceeded;
     }
@@ -755,7 +754,9 @@ void World::collideCloths(Real frameDt, StepStats& stats) {
     // The pass moved vertices after the cloths measured their strain: the frame ends here.
     stats.maxStrain = 0;
     for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-      if (slot->cloth) stats.maxStrain = std::max(stats.maxStrain, slot->cloth->maxStrain());
+      if (!slot->cloth) continue;
+      slot->frameStrain = slot->cloth->maxStrain();
+      stats.maxStrain = std::max(stats.maxStrain, slot->frameStrain);
     }
   }
   stats.clothContacts += report.proximityContacts;
