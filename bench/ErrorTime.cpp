@@ -30,6 +30,7 @@
 // left out of its statistics.
 #include "ErrorTime.h"
 
+#include "BenchClock.h"
 #include "ClothStatistics.h"
 
 #if WEFT_HAVE_BULLET
@@ -43,7 +44,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -63,11 +63,7 @@ constexpr Index kSampleEveryFrames = 6;  // 0.1 s
 constexpr Real kResolution = 10;         // a ranked error is at least this × the reference's
 constexpr Real kTimingNoise = 0.1;       // CPU-time differences under 10 % are not a ranking
 
-double threadCpuSeconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
-}
+using bench::threadCpuSeconds;
 
 // One cloth state at a sample time, with what the statistics need beyond the positions.
 struct Sample {

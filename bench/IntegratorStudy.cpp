@@ -9,6 +9,7 @@
 // otherwise default settings, for ten periods: the amplitude kept per period and the period,
 // measured from the swing's turning points and zero crossings, beside the closed forms of the
 // method on the linear swing (PendulumScene::growthFactor).
+#include "BenchClock.h"
 #include "ErrorTime.h"
 
 #include <weft/scenes/FreeDrape.h>
@@ -16,7 +17,6 @@
 
 #include <cmath>
 #include <cstdlib>
-#include <ctime>
 #include <iomanip>
 #include <numbers>
 #include <sstream>
@@ -26,11 +26,7 @@
 namespace weft {
 namespace {
 
-double threadCpuSeconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return double(now.tv_sec) + 1e-9 * double(now.tv_nsec);
-}
+using bench::threadCpuSeconds;
 
 struct DrapeRun {
   std::vector<Vec3Array> samples;  // every 0.1 s

@@ -25,6 +25,23 @@ constexpr Real kColliderMarginPerEdge = 0.5;
 constexpr int kStrainRounds = 2;
 
 // Adds the counters the substeps of an attempt collect to the frame's statistics.
+// Whether `strain` is past the cloth's strain limit + kStrainLimitSlack (no limit: never).
+bool pastLimit(const Cloth& cloth, Real strain) {
+  const Real limit = cloth.settings().material.strainLimit;
+  return limit > 0 && std::isfinite(limit) && strain > limit + kStrainLimitSlack;
+}
+
+// The strain `cloth` ends the frame with, into the stats; a cloth past its limit is reported,
+// never passed off as ok (StepStatus::StrainLimitExceeded).
+void reportStrain(const Cloth& cloth, StepStats& stats) {
+  const Real strain = cloth.maxStrain();
+  stats.maxStrain = std::max(stats.maxStrain, strain);
+  if (pastLimit(cloth, strain)) {
+    ++stats.clothsOverStrainLimit;
+    stats.status |= StepStatus::StrainLimitExceeded;
+  }
+}
+
 void addSubstepCounters(const StepStats& from, StepStats& to) {
   to.assemblyMs += from.assemblyMs;
   to.solveMs += from.solveMs;
@@ -118,7 +135,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
   }
   if (!anyStepping) {
     for (Cloth* cloth : cloths) {
-      stats.maxStrain = std::max(stats.maxStrain, cloth->maxStrain());
+      reportStrain(*cloth, stats);
       stats.potentialEnergy += cloth->lastPotential();
     }
     return;
@@ -215,7 +232,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     const ClothStageCounts counts = cloth.takeStageCounts();
     stats.bendingAssemblies += counts.bendingAssemblies;
     stats.dampingJacobians += counts.dampingJacobians;
-    stats.maxStrain = std::max(stats.maxStrain, cloth.maxStrain());
+    reportStrain(cloth, stats);
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
     stats.potentialEnergy += cloth.lastPotential();
@@ -236,11 +253,7 @@ Index SubstepPipeline::strainRetryLimit(std::span<Cloth* const> cloths, const St
 
 bool SubstepPipeline::pastStrainLimit(std::span<Cloth* const> cloths) const {
   for (std::size_t c = 0; c < cloths.size(); ++c) {
-    if (!m_stepping[c]) continue;
-    const Real limit = cloths[c]->settings().material.strainLimit;
-    if (limit > 0 && std::isfinite(limit) && cloths[c]->maxStrain() > limit + kStrainLimitSlack) {
-      return true;
-    }
+    if (m_stepping[c] && pastLimit(*cloths[c], cloths[c]->maxStrain())) return true;
   }
   return false;
 }

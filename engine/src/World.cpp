@@ -601,18 +601,6 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
     }
   }
   const Index totalSubsteps = stats.substeps * (Index(m_steppedCloths.size()) - stats.sleepingCloths);
-  // The strain every cloth ends the frame with; a cloth past its limit + slack is reported,
-  // never passed off as ok.
-  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-    if (!slot->cloth) continue;
-    const Real strain = slot->cloth->maxStrain();
-    stats.maxStrain = std::max(stats.maxStrain, strain);
-    const Real limit = slot->cloth->settings().material.strainLimit;
-    if (limit > 0 && std::isfinite(limit) && strain > limit + kStrainLimitSlack) {
-      ++stats.clothsOverStrainLimit;
-      stats.status |= StepStatus::StrainLimitExceeded;
-    }
-  }
   m_time += frameDt;
   stats.simulatedTime = m_time;
   stats.stepMs =
