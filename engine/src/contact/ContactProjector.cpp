@@ -232,28 +232,26 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   // along its whole path relative to the body over the substep, so that a vertex a fast or thin
   // body passed through is found although it ends clear of it.
   const bool firstVisit = !m_visited[index];
+  Vec3 shift = Vec3::Zero();
   if (before.distance < thickness || firstVisit) {
     const Vec3 outside =
         firstVisit ? keepOutside(collider, space.startX[i], x, thickness)
                    : keepOutsideFrom(collider.shape, m_lastOutside[index], x, thickness);
-    const Vec3 shift = outside - x;
+    shift = outside - x;
     if (!shift.isZero()) {
       depth = std::max<Real>(thickness - before.distance, shift.norm());
       x = outside;
-      m_pushed[index] += std::max<Real>(0, shift.dot(queryPoint(collider.shape, x).normal));
     }
     m_visited[index] = 1;
   }
   m_lastOutside[index] = x;
-  {
-    // Resting on the body now: the edges slide the vertex on it (sweepEdges).
-    const ShapeContact on = queryPoint(collider.shape, x);
-    m_surfaceNormal[i] = on.distance < (1 + kOnSurfaceShell) * thickness ? on.normal : Vec3::Zero();
-  }
-  if (!m_frictionOn || !contact.resting || !(contact.friction > 0)) return depth;
+  const ShapeContact on = shift.isZero() ? before : queryPoint(collider.shape, x);
+  m_pushed[index] += std::max<Real>(0, shift.dot(on.normal));
+  // Resting on the body now: the edges slide the vertex on it (sweepEdges).
+  const bool onSurface = on.distance < (1 + kOnSurfaceShell) * thickness;
+  m_surfaceNormal[i] = onSurface ? on.normal : Vec3::Zero();
+  if (!m_frictionOn || !contact.resting || !(contact.friction > 0) || !onSurface) return depth;
   // Static and kinetic friction on the substep's displacement relative to the body.
-  const ShapeContact on = queryPoint(collider.shape, x);
-  if (!(on.distance < (1 + kOnSurfaceShell) * thickness)) return depth;
   const Real normal = h * contact.solveImpulse +
                      std::max<Real>(0, on.normal.dot(x - m_solved[i]));
   Vec3 slip = x - collider.carry(space.startX[i]);
