@@ -92,6 +92,8 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   const std::size_t count = set.size();
   m_pushed.assign(count, 0);
   m_visited.assign(count, 0);
+  m_moves.assign(space.vertexCount(), 0);
+  m_edgeSeenMoves.assign(space.edges.size(), std::numeric_limits<std::uint64_t>::max());
   m_solved = space.x;
   m_touching.assign(space.vertexCount(), 0);
   m_surfaceNormal.assign(space.vertexCount(), Vec3::Zero());
@@ -132,6 +134,14 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   return report;
 }
 
+void ContactProjector::markIfWithin(const ContactSpace& space, Index e) {
+  const Index a = space.edges[e][0], b = space.edges[e][1];
+  // Measured as the sweep measures it: a correction can leave the edge a rounding error long.
+  if ((space.x[b] - space.x[a]).norm() <= space.longest[e]) {
+    m_edgeSeenMoves[e] = std::uint64_t(m_moves[a]) + m_moves[b];
+  }
+}
+
 Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool backward) {
   const Index edgeCount = Index(space.edges.size());
   Index over = 0;
@@ -147,19 +157,29 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
     over += length > longest * (1 + tolerance);
     const Vec3 shift = ((longest - length) / length) * delta;
     space.x[i] += shift;
+    ++m_moves[i];
   }
   const bool ordered = space.edgeOrder.size() == space.edges.size();
   const bool anchored = space.anchorDistance.size() == space.x.size() && m_followTheLeader;
   for (Index k = 0; k < edgeCount; ++k) {
     const Index slot = backward ? edgeCount - 1 - k : k;
     const Index e = ordered ? space.edgeOrder[slot] : slot;
-    const Real longest = space.longest[e];
     const Index a = space.edges[e][0], b = space.edges[e][1];
+    // Left within its limit at its last visit, and neither end moved since: still within it.
+    const std::uint64_t moves = std::uint64_t(m_moves[a]) + m_moves[b];
+    if (moves == m_edgeSeenMoves[e]) continue;
+    const Real longest = space.longest[e];
     const Vec3 delta = space.x[b] - space.x[a];
     const Real length = delta.norm();
-    if (!(length > longest)) continue;
+    if (!(length > longest)) {
+      m_edgeSeenMoves[e] = moves;
+      continue;
+    }
     Real weightA = space.inverseMass[a], weightB = space.inverseMass[b];
-    if (weightA + weightB == 0) continue;  // both ends pinned: nothing can shorten it
+    if (weightA + weightB == 0) {  // both ends pinned: nothing can shorten it
+      m_edgeSeenMoves[e] = moves;
+      continue;
+    }
     over += length > longest + tolerance * space.restLengths[e];
     const Vec3& normalA = m_surfaceNormal[a];
     const Vec3& normalB = m_surfaceNormal[b];
@@ -177,6 +197,9 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
       const Real fraction = heldStepFraction(delta, shiftB - shiftA, longest);
       space.x[a] += fraction * shiftA;
       space.x[b] += fraction * shiftB;
+      m_moves[a] += !shiftA.isZero() && fraction > 0;
+      m_moves[b] += !shiftB.isZero() && fraction > 0;
+      markIfWithin(space, e);
       continue;
     }
     // Follow the leader: the end nearer the pins stays, unless the other cannot move or either
@@ -189,6 +212,9 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
     const Vec3 impulse = ((length - longest) / ((weightA + weightB) * length)) * delta;
     space.x[a] += weightA * impulse;
     space.x[b] -= weightB * impulse;
+    m_moves[a] += weightA > 0;
+    m_moves[b] += weightB > 0;
+    markIfWithin(space, e);
   }
   return over;
 }
@@ -241,6 +267,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
     if (!shift.isZero()) {
       depth = std::max<Real>(thickness - before.distance, shift.norm());
       x = outside;
+      ++m_moves[i];
     }
     m_visited[index] = 1;
   }
@@ -260,6 +287,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   applied -= applied.dot(on.normal) * on.normal;
   const Vec3 correction = frictionCorrection(slip, applied, normal, contact.friction);
   x += correction - applied;
+  m_moves[i] += correction != applied;
   m_friction[index] = correction;
   return std::max(depth, (correction - applied).norm());
 }
@@ -271,6 +299,9 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   const Real depth = pushFaceOut(set.cores[contact.core], contact.normal, collider.end.pose, corner,
                                  space.inverseMass, space.x, space.v, 0, normal);
   m_pushed[index] += depth;
+  if (depth > 0) {
+    for (Index i : corner) ++m_moves[i];
+  }
   if (!m_frictionOn || !contact.resting || !(contact.friction > 0)) return depth;
   // Friction at the face's centroid over the corners that are not on the body themselves (those
   // take it as vertex contacts), with the body's normal where the face touches it.
@@ -311,6 +342,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   const Vec3 change = correction - applied;
   for (int j = 0; j < 3; ++j) {
     space.x[corner[j]] += (b[j] * space.inverseMass[corner[j]] / weight) * change;
+    m_moves[corner[j]] += b[j] > 0 && !change.isZero();
   }
   m_friction[index] = correction;
   return std::max(depth, change.norm());
@@ -328,7 +360,10 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
     const Vec3 lambda = relativeChange / weight;
     for (int k = 0; k < 4; ++k) {
       const Index i = contact.vertices[k];
-      if (space.inverseMass[i] > 0) space.x[i] += (contact.weights[k] * inverseMass) * lambda;
+      if (space.inverseMass[i] > 0 && contact.weights[k] != 0) {
+        space.x[i] += (contact.weights[k] * inverseMass) * lambda;
+        m_moves[i] += !lambda.isZero();
+      }
     }
   };
   if (shortfall > 0) {

@@ -20,6 +20,9 @@
 //    every movable vertex counts as heavy as the pair's heaviest, so that a light sheet under a
 //    heavy body does not take almost all of every correction (it would give it back to its edges
 //    on the next sweep and converge at m_light / m_heavy per iteration).
+// An edge left within its limit whose ends have not moved since (each vertex counts its moves)
+// is skipped, which changes nothing (its correction would be none): the late sweeps, where a few
+// edges are still converging, measure only the edges near them.
 // Every position change Δx is made as the velocity change Δx / h too, so v stays the substep's
 // average velocity. Sweeps alternate direction; the iteration stops when no edge is over its
 // limit by more than the tolerance and no contact is violated by more than its tolerance.
@@ -51,6 +54,7 @@
 #include "contact/ContactDetector.h"
 #include "contact/ContactSpace.h"
 
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -86,6 +90,8 @@ class ContactProjector {
   // One Gauss–Seidel sweep over the edges over their limit; returns how many were over
   // limit + tolerance before their correction.
   Index sweepEdges(ContactSpace& space, Real tolerance, bool backward);
+  // Marks edge e as seen within its limit when it is (sweepEdges skips it until an end moves).
+  void markIfWithin(const ContactSpace& space, Index e);
   // One sweep over the contacts; returns how many were violated beyond tolerance.
   Index sweepContacts(ContactSpace& space, const ContactSet& set,
                       std::span<const ColliderFrame> colliders, Real h, Real tolerance,
@@ -105,9 +111,11 @@ class ContactProjector {
   Vec3Array m_lastOutside;        // vertex contacts: where the vertex last was outside
   bool m_frictionOn = true;       // friction acts in this sweep
   bool m_followTheLeader = true;  // edges move only their end farther from the pins
-  std::vector<char> m_visited;
+  std::vector<char> m_visited;    // vertex contacts: path tested from the start already
   std::vector<char> m_touching;   // per vertex: in a contact of the set
-  Vec3Array m_surfaceNormal;      // per vertex: the collider surface it rests on, zero if none    // vertex contacts: path tested from the start already
+  std::vector<std::uint32_t> m_moves;  // per vertex: how many times the projection moved it
+  std::vector<std::uint64_t> m_edgeSeenMoves;  // per edge: its ends' m_moves after its last visit
+  Vec3Array m_surfaceNormal;      // per vertex: the collider surface it rests on, zero if none
   Vec3Array m_solved;             // the positions the projection started from (the solve's)
 };
 
