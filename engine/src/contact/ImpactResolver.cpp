@@ -258,6 +258,18 @@ void ImpactResolver::applyImpulse(const Impact& impact, Real targetNormalSpeed,
   }
 }
 
+bool ImpactResolver::usesDetectedPairs() const {
+  // The detection's feature pairs were found over x₀ → x₁ with a margin R; a swept box over
+  // x₀ → x₂ with a margin δ lies within the box of the same feature grown by the largest move d
+  // from x₁ to x₂, so every pair it would find is among them when 2d + δ ≤ R.
+  if (!m_detected.features || m_detected.endPositions.size() != m_end.size()) return false;
+  Real moved = 0;
+  for (std::size_t i = 0; i < m_end.size(); ++i) {
+    moved = std::max(moved, (m_end[i] - m_detected.endPositions[i]).cwiseAbs().maxCoeff());
+  }
+  return 2 * moved + kSweptInflate <= m_detected.margin;
+}
+
 bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   const Vec3Array& start = space.startX;
   const Index n = space.vertexCount();
@@ -273,12 +285,12 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   }
   m_impacts.clear();
   if (!any) return false;
-  // The first test may take the detection's feature pairs when they hold every pair this one
-  // would find (see resolve()); later ones restrict the search to the dirty vertices.
+  // The detection's feature pairs hold every pair this test would find while no end moved
+  // farther from the detection's ends than (margin − inflate) / 2: each swept box then lies within
+  // the detection's box of the same feature. Otherwise a search of its own over the dirty vertices.
   const FeaturePairs* features = &m_features;
-  if (m_candidates) {
-    features = m_candidates;
-    m_candidates = nullptr;
+  if (usesDetectedPairs()) {
+    features = m_detected.features;
   } else {
     m_features.find(space, start, m_end, kSweptInflate, &m_dirty);
   }
@@ -290,6 +302,8 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
     if (pair < vertexTriangleCount) {
       const auto& [vertex, triangle] = vertexTriangle[pair];
       const std::array<Index, 3>& c = space.triangles[triangle];
+      // A pair without a dirty vertex tests as it did last time: negative.
+      if (!m_dirty[vertex] && !m_dirty[c[0]] && !m_dirty[c[1]] && !m_dirty[c[2]]) return false;
       if (!sweptBoxesMeet({vertex}, {c[0], c[1], c[2]}, start, m_end)) return false;
       const std::array<Vec3, 3> triangleStart{start[c[0]], start[c[1]], start[c[2]]};
       const std::array<Vec3, 3> triangleEnd{m_end[c[0]], m_end[c[1]], m_end[c[2]]};
@@ -313,6 +327,7 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
     const auto& [firstEdge, secondEdge] = edgeEdge[pair - vertexTriangleCount];
     const std::array<Index, 2>& p = space.edges[firstEdge];
     const std::array<Index, 2>& q = space.edges[secondEdge];
+    if (!m_dirty[p[0]] && !m_dirty[p[1]] && !m_dirty[q[0]] && !m_dirty[q[1]]) return false;
     if (!sweptBoxesMeet({p[0], p[1]}, {q[0], q[1]}, start, m_end)) return false;
     const std::optional<EdgeEdgeImpact> hit =
         sweptEdgeEdge({start[p[0]], start[p[1]]}, {m_end[p[0]], m_end[p[1]]},
@@ -418,18 +433,7 @@ ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
   }
   report.colliderCorrections = keepOutOfColliders(space, set, colliders);
   if (!pairs) return report;
-  // The detection's feature pairs were found over x₀ → x₁ with a margin R; this stage's swept
-  // boxes over x₀ → x₂ with a margin δ lie within those boxes grown by the largest move d from x₁
-  // to x₂, so every pair it would find is among them when 2d + δ ≤ R. Then the first swept test
-  // runs over them instead of a broad phase of its own (the extra pairs test negative).
-  m_candidates = nullptr;
-  if (detected.features && !detected.endPositions.empty()) {
-    Real moved = 0;
-    for (Index i = 0; i < space.vertexCount(); ++i) {
-      moved = std::max(moved, (space.x[i] - detected.endPositions[i]).cwiseAbs().maxCoeff());
-    }
-    if (2 * moved + kSweptInflate <= detected.margin) m_candidates = detected.features;
-  }
+  m_detected = detected;
   const Index n = space.vertexCount();
   const Vec3Array& start = space.startX;
   for (Index i = 0; i < n; ++i) m_velocity[i] = (space.x[i] - start[i]) / h;
@@ -485,6 +489,7 @@ ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
     space.v[i] += m_velocity[i] - (space.x[i] - start[i]) / h;
     space.x[i] = start[i] + h * m_velocity[i];
   }
+  m_detected = {};  // its spans are the caller's, valid for this call only
   return report;
 }
 

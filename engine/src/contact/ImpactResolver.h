@@ -46,7 +46,7 @@
 namespace weft {
 
 /// The feature pairs the detection found this substep, over x₀ → `endPositions` with `margin`
-/// (m): the impact stage's first swept test reuses them when the stages between moved little.
+/// (m): the impact stage's swept tests reuse them while the stages between moved little.
 struct DetectedPairs {
   const FeaturePairs* features = nullptr;
   std::span<const Vec3> endPositions;
@@ -93,6 +93,8 @@ class ImpactResolver {
   void rigidifyZones(const ContactSpace& space);
   Real impulseInverseMass(Index vertex, const ContactSpace& space);
   void clampToColliders(const ContactSpace& space, Real h);
+  // Whether the detection's feature pairs hold every pair the next swept test can find.
+  bool usesDetectedPairs() const;
   // keepOutside() for `vertex` ending at `end`: traced from where the projection left it when
   // the projection followed it as a collider contact (the body at its end pose), else over the
   // substep from x₀.
@@ -102,7 +104,7 @@ class ImpactResolver {
   TaskSystem* m_tasks = nullptr;
   bool m_skip = true;
   FeaturePairs m_features;
-  const FeaturePairs* m_candidates = nullptr;  // the detection's, for the first swept test
+  DetectedPairs m_detected;  // the detection's pairs, reused while every end stays within reach
   std::span<const ColliderFrame> m_colliders;
   const ContactSet* m_set = nullptr;  // this substep's, for its face contacts
   std::vector<Index> m_near;                 // colliders near the cloth this substep
