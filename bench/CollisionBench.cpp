@@ -2,13 +2,15 @@
 // folds, the heaviest self-contact), at sizes 1, 4, 16 and on 1 and 2 threads:
 //   CollisionRefit      the BVH refit to the step's swept boxes
 //   CollisionSelfQuery  the BVH self query (candidate triangle pairs)
-//   CollisionResolve    one whole SelfCollision::resolve of a step (proximity, swept tests,
-//                       impulses); its counters split it into the profiler zones broad_ms,
-//                       narrow_ms (exact feature tests) and response_ms (impulses, zones), per call
+//   CollisionDetect     the contact detection of a step (broad phase, feature pairs, closest
+//                       points at both ends); counters: broad_ms, features_ms, narrow_ms per call
+//   CollisionImpacts    the impact stage of a step (swept tests, impulses, impact zones)
 //   CurtainStep         whole frames of the curtain script with self-collision on and off
 // Run in Release: build/bench/weft-bench --benchmark_filter='Collision|CurtainStep'
 // Arguments are {size, threads} (and {self} for CurtainStep).
-#include "SelfCollision.h"
+#include "Cloth.h"
+#include "contact/ContactDetector.h"
+#include "contact/ImpactResolver.h"
 
 #include <weft/scenes/Curtain.h>
 #include <weft/threading/Profiler.h>
@@ -97,40 +99,88 @@ void CollisionSelfQuery(benchmark::State& state) {
   state.counters["pairs"] = double(pairs.size());
 }
 
-void CollisionResolve(benchmark::State& state) {
-  GatheredCurtain& curtain = gathered(Index(state.range(0)));
-  TaskSystem& taskSystem = tasks(int(state.range(1)));
-  SelfCollision selfCollision(*curtain.model, &taskSystem);
-  const Vec3Array end = stepEnd(curtain);
-  Vec3Array x = end, v = curtain.velocity;
-  const Real h = CurtainScene::kFrameDt;
-  // One call before timing sizes every buffer.
-  SelfCollisionReport report = selfCollision.resolve(curtain.start, h, curtain.material.thickness,
-                                                     curtain.material.friction, curtain.inverseMasses, x, v);
-  Profiler& profiler = Profiler::instance();
-  profiler.clear();
-  const std::uint64_t profileFrame = 1'000'000 + 100 * std::uint64_t(state.range(0)) + state.range(1);
-  profiler.beginFrame(profileFrame);
-  profiler.setEnabled(true);
-  for (auto _ : state) {
-    x = end;
-    v = curtain.velocity;
-    report = selfCollision.resolve(curtain.start, h, curtain.material.thickness,
-                                   curtain.material.friction, curtain.inverseMasses, x, v);
+// The gathered curtain as a one-cloth contact space, its step ending at stepEnd().
+struct GatheredSpace {
+  std::unique_ptr<Cloth> cloth;
+  ContactSpace space;
+
+  GatheredSpace(GatheredCurtain& curtain, TaskSystem& taskSystem) {
+    ClothSettings settings;
+    settings.material = curtain.material;
+    const Index columns = curtain.model->gridSize()[0], rows = curtain.model->gridSize()[1];
+    for (Index c = 0; c < columns; ++c) settings.pinnedVertices.push_back((rows - 1) * columns + c);
+    cloth = Cloth::create(curtain.model, settings, WorldSettings{}, &taskSystem).value();
+    (void)cloth->setState(curtain.start, curtain.velocity);
+    Cloth* cloths[] = {cloth.get()};
+    space.build(cloths);
   }
-  profiler.setEnabled(false);
+  void reset(const GatheredCurtain& curtain, const Vec3Array& end) {
+    space.startX = curtain.start;
+    space.startV = curtain.velocity;
+    space.x = end;
+    space.v = curtain.velocity;
+  }
+};
+
+void recordZones(benchmark::State& state, std::uint64_t frame) {
+  Profiler& profiler = Profiler::instance();
   const double calls = double(state.iterations());
-  for (const ZoneTotal& zone : profiler.frameTotals(profileFrame)) {
+  for (const ZoneTotal& zone : profiler.frameTotals(frame)) {
     if (zone.name == "broad phase") state.counters["broad_ms"] = zone.totalMs / calls;
-    if (zone.name == "narrow phase") state.counters["narrow_ms"] = zone.totalMs / calls;
-    if (zone.name == "response") state.counters["response_ms"] = zone.totalMs / calls;
-    if (zone.name == "impact zones") state.counters["zones_ms"] = zone.totalMs / calls;
     if (zone.name == "feature pairs") state.counters["features_ms"] = zone.totalMs / calls;
-    if (zone.name == "feature sort") state.counters["sort_ms"] = zone.totalMs / calls;
+    if (zone.name == "narrow phase") state.counters["narrow_ms"] = zone.totalMs / calls;
+    if (zone.name == "swept tests") state.counters["swept_ms"] = zone.totalMs / calls;
+    if (zone.name == "impact zones") state.counters["zones_ms"] = zone.totalMs / calls;
   }
   state.counters["dropped_zones"] = double(profiler.droppedCount());
   profiler.clear();
-  state.counters["proximity"] = double(report.proximityContacts);
+}
+
+void CollisionDetect(benchmark::State& state) {
+  GatheredCurtain& curtain = gathered(Index(state.range(0)));
+  TaskSystem& taskSystem = tasks(int(state.range(1)));
+  GatheredSpace gatheredSpace(curtain, taskSystem);
+  gatheredSpace.reset(curtain, stepEnd(curtain));
+  ContactDetector detector;
+  detector.build(gatheredSpace.space, &taskSystem);
+  ContactSet set;
+  DetectionCounts counts;
+  detector.detect(gatheredSpace.space, {}, {}, {}, true, 0, set, counts);  // sizes every buffer
+  Profiler& profiler = Profiler::instance();
+  profiler.clear();
+  const std::uint64_t frame = 1'000'000 + 100 * std::uint64_t(state.range(0)) + state.range(1);
+  profiler.beginFrame(frame);
+  profiler.setEnabled(true);
+  for (auto _ : state) {
+    detector.detect(gatheredSpace.space, {}, {}, {}, true, 0, set, counts);
+    benchmark::DoNotOptimize(set.contacts.data());
+  }
+  profiler.setEnabled(false);
+  recordZones(state, frame);
+  state.counters["contacts"] = double(set.size());
+}
+
+void CollisionImpacts(benchmark::State& state) {
+  GatheredCurtain& curtain = gathered(Index(state.range(0)));
+  TaskSystem& taskSystem = tasks(int(state.range(1)));
+  GatheredSpace gatheredSpace(curtain, taskSystem);
+  const Vec3Array end = stepEnd(curtain);
+  ImpactResolver impacts;
+  impacts.build(gatheredSpace.space, &taskSystem);
+  const Real h = CurtainScene::kFrameDt;
+  gatheredSpace.reset(curtain, end);
+  ImpactReport report = impacts.resolve(gatheredSpace.space, ContactSet{}, {}, h, true);  // sizes every buffer
+  Profiler& profiler = Profiler::instance();
+  profiler.clear();
+  const std::uint64_t frame = 2'000'000 + 100 * std::uint64_t(state.range(0)) + state.range(1);
+  profiler.beginFrame(frame);
+  profiler.setEnabled(true);
+  for (auto _ : state) {
+    gatheredSpace.reset(curtain, end);
+    report = impacts.resolve(gatheredSpace.space, ContactSet{}, {}, h, true);
+  }
+  profiler.setEnabled(false);
+  recordZones(state, frame);
   state.counters["impacts"] = double(report.impacts);
 }
 
@@ -162,7 +212,8 @@ void CurtainStep(benchmark::State& state) {
 BENCHMARK(CollisionRefit) WEFT_COLLISION_SIZES;
 BENCHMARK(CollisionSelfQuery) WEFT_COLLISION_SIZES;
 // A fixed number of calls keeps the profiler's zone buffers from filling up.
-BENCHMARK(CollisionResolve) WEFT_COLLISION_SIZES->Iterations(40);
+BENCHMARK(CollisionDetect) WEFT_COLLISION_SIZES->Iterations(40);
+BENCHMARK(CollisionImpacts) WEFT_COLLISION_SIZES->Iterations(40);
 BENCHMARK(CurtainStep)
     ->ArgsProduct({{1, 4, 16}, {1, 2}, {0, 1}})
     ->ArgNames({"size", "threads", "self"})

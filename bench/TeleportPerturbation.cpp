@@ -63,7 +63,7 @@ struct Outcome {
 };
 
 Outcome runScene(const Perturbation& perturbation, Real jump, Real teleportDistance,
-                 Real selfContactStiffness, bool formerSolve, std::FILE* trace) {
+                 bool formerSolve, std::FILE* trace) {
   GridSettings grid;
   grid.columns = kColumns;
   grid.rows = kRows;
@@ -76,7 +76,6 @@ Outcome runScene(const Perturbation& perturbation, Real jump, Real teleportDista
   settings.solver.removePinnedVertices = perturbation.removePins;
   settings.sleep.enabled = perturbation.sleep;
   if (teleportDistance >= 0) settings.solver.pinTeleportDistance = teleportDistance;
-  if (selfContactStiffness >= 0) settings.solver.selfContactStiffness = selfContactStiffness;
   if (formerSolve) {
     settings.solver.cgTolerance = 1e-3;
     settings.solver.cgStopping = PcgStopping::RelativeResidual;
@@ -176,10 +175,6 @@ int main(int argc, char** argv) {
   app.add_option("--pin-teleport-distance", teleportDistance,
                  "SolverSettings::pinTeleportDistance (cloth sizes; 0 = pins drag the cloth through "
                  "the jump); default: the engine's");
-  Real selfContactStiffness = -1;
-  app.add_option("--self-contact-stiffness", selfContactStiffness,
-                 "SolverSettings::selfContactStiffness (times the stretch stiffness; 0 = off); "
-                 "default: the engine's");
   bool formerSolve = false;
   app.add_flag("--former-default-solve", formerSolve,
                "every solve at the relative residual 1e-3 (the default before the contact-aware "
@@ -199,7 +194,7 @@ int main(int argc, char** argv) {
   int failures = 0;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     std::FILE* trace = int(k) == traceRun ? std::fopen(tracePath.c_str(), "w") : nullptr;
-    const Outcome outcome = runScene(runs[k], jump, teleportDistance, selfContactStiffness, formerSolve, trace);
+    const Outcome outcome = runScene(runs[k], jump, teleportDistance, formerSolve, trace);
     if (trace) std::fclose(trace);
     const bool passed = outcome.passed(jump);
     failures += !passed;

@@ -55,6 +55,12 @@ void addQuadraticRootsAndVertex(Real q0, Real q1, Real q2, CandidateTimes& candi
 }
 
 CandidateTimes cubicCandidateTimes(const Cubic& f, Real slack) {
+  // On [0, 1] the cubic lies within the range of its Bernstein coefficients (it is their convex
+  // combination): when they all stay beyond ±slack, it cannot come within the slack of zero.
+  // Most pairs resting side by side end here, without the derivative's roots.
+  const Real b0 = f.c0, b1 = f.c0 + f.c1 / 3, b2 = f.c0 + (2 * f.c1 + f.c2) / 3,
+             b3 = f.c0 + f.c1 + f.c2 + f.c3;
+  if (std::min({b0, b1, b2, b3}) > slack || std::max({b0, b1, b2, b3}) < -slack) return {};
   // Piece ends: 0, the roots (and vertex) of f′ = 3 c3 t² + 2 c2 t + c1 inside (0, 1), 1.
   CandidateTimes breaks;
   breaks.add(0);

@@ -115,28 +115,29 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
 
   TriangleMeshShape shape;
   if (Status status = shape.setMotion(motion); !status) return status.error();
-  shape.m_localVertices.assign(localVertices.begin(), localVertices.end());
-  shape.m_indices.assign(indices.begin(), indices.end());
-  Result<Bvh> tree = Bvh::build(shape.m_indices, shape.m_localVertices, kLeafTriangles);
+  auto geometry = std::make_shared<Geometry>();
+  geometry->vertices.assign(localVertices.begin(), localVertices.end());
+  geometry->indices.assign(indices.begin(), indices.end());
+  Result<Bvh> tree = Bvh::build(geometry->indices, geometry->vertices, kLeafTriangles);
   if (!tree) return tree.error();
-  shape.m_localBvh = std::move(tree).value();
+  geometry->bvh = std::move(tree).value();
 
   // Face normals, angle-weighted vertex normals.
-  const auto& x = shape.m_localVertices;
-  shape.m_faceNormals.resize(triangleCount);
-  shape.m_corners.resize(3 * std::size_t(triangleCount));
-  shape.m_vertexNormals.assign(x.size(), Vec3::Zero());
+  const auto& x = geometry->vertices;
+  geometry->faceNormals.resize(triangleCount);
+  geometry->corners.resize(3 * std::size_t(triangleCount));
+  geometry->vertexNormals.assign(x.size(), Vec3::Zero());
   for (Index t = 0; t < triangleCount; ++t) {
     const Index corner[3] = {indices[3 * t], indices[3 * t + 1], indices[3 * t + 2]};
     const Vec3 normal = (x[corner[1]] - x[corner[0]]).cross(x[corner[2]] - x[corner[0]]).normalized();
-    shape.m_faceNormals[t] = normal;
-    for (int k = 0; k < 3; ++k) shape.m_corners[3 * t + k] = x[corner[k]];
+    geometry->faceNormals[t] = normal;
+    for (int k = 0; k < 3; ++k) geometry->corners[3 * t + k] = x[corner[k]];
     for (int k = 0; k < 3; ++k) {
       const Real angle = cornerAngle(x[corner[k]], x[corner[(k + 1) % 3]], x[corner[(k + 2) % 3]]);
-      shape.m_vertexNormals[corner[k]] += angle * normal;
+      geometry->vertexNormals[corner[k]] += angle * normal;
     }
   }
-  for (Vec3& n : shape.m_vertexNormals) {
+  for (Vec3& n : geometry->vertexNormals) {
     if (n.squaredNorm() > 0) n.normalize();
   }
 
@@ -151,27 +152,28 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
     }
   }
   std::sort(edgeSlots.begin(), edgeSlots.end());
-  shape.m_edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
-  shape.m_closed = true;
+  geometry->edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
+  geometry->closed = true;
   for (std::size_t begin = 0; begin < edgeSlots.size();) {
     std::size_t end = begin;
     Vec3 sum = Vec3::Zero();
     while (end < edgeSlots.size() && edgeSlots[end].first == edgeSlots[begin].first) {
-      sum += shape.m_faceNormals[edgeSlots[end].second / 3];
+      sum += geometry->faceNormals[edgeSlots[end].second / 3];
       ++end;
     }
     // Closed: every edge has exactly two triangles (a border edge has one, a fin three or more).
-    if (end - begin != 2) shape.m_closed = false;
+    if (end - begin != 2) geometry->closed = false;
     if (sum.squaredNorm() > 0) sum.normalize();
-    for (std::size_t i = begin; i < end; ++i) shape.m_edgeNormals[edgeSlots[i].second] = sum;
+    for (std::size_t i = begin; i < end; ++i) geometry->edgeNormals[edgeSlots[i].second] = sum;
     begin = end;
   }
+  shape.m_geometry = std::move(geometry);
   return shape;
 }
 
 void TriangleMeshShape::worldVertices(std::span<Vec3> vertices) const {
-  for (std::size_t v = 0; v < m_localVertices.size() && v < vertices.size(); ++v) {
-    vertices[v] = m_motion.pose.toWorld(m_localVertices[v]);
+  for (std::size_t v = 0; v < m_geometry->vertices.size() && v < vertices.size(); ++v) {
+    vertices[v] = m_motion.pose.toWorld(m_geometry->vertices[v]);
   }
 }
 
@@ -183,7 +185,7 @@ Status TriangleMeshShape::setMotion(const RigidMotion& motion) {
 }
 
 Index TriangleMeshShape::closestTriangle(const Vec3& local, Real maxSquared) const {
-  const std::vector<Bvh::Node>& nodes = m_localBvh.nodes();
+  const std::vector<Bvh::Node>& nodes = m_geometry->bvh.nodes();
   // Best-first descent with a fixed stack (one pending sibling per level).
   Real bestSquared = maxSquared;
   Index bestTriangle = kInvalidIndex;
@@ -194,10 +196,10 @@ Index TriangleMeshShape::closestTriangle(const Vec3& local, Real maxSquared) con
     const Bvh::Node& node = nodes[stack[--top]];
     if (node.bounds.squaredDistanceTo(local) >= bestSquared) continue;
     if (node.isLeaf()) {
-      for (Index t : m_localBvh.leafTriangles(node)) {
-        const Vec3* corner = &m_corners[3 * t];
+      for (Index t : m_geometry->bvh.leafTriangles(node)) {
+        const Vec3* corner = &m_geometry->corners[3 * t];
         // The distance to the triangle's plane bounds the distance to the triangle from below.
-        const Real plane = m_faceNormals[t].dot(local - corner[0]);
+        const Real plane = m_geometry->faceNormals[t].dot(local - corner[0]);
         if (plane * plane >= bestSquared) continue;
         const Real squared = squaredDistanceToTriangle(local, corner[0], corner[1], corner[2]);
         // Strictly closer only: among equal distances the first one found (a fixed order) wins.
@@ -238,26 +240,26 @@ std::optional<ShapeContact> TriangleMeshShape::queryPointWithin(const Vec3& poin
 }
 
 ShapeContact TriangleMeshShape::contactWith(const Vec3& local, Index triangle) const {
-  const Vec3* corner = &m_corners[3 * triangle];
+  const Vec3* corner = &m_geometry->corners[3 * triangle];
   const TriangleClosestPoint best = closestPointOnTriangle(local, corner[0], corner[1], corner[2]);
   const Vec3 offset = local - best.point;
-  if (!m_closed) {
+  if (!m_geometry->closed) {
     // A two-sided shell: the unsigned distance, the normal towards the side the point is on.
-    const Vec3 normal = best.distance > 0 ? Vec3(offset / best.distance) : m_faceNormals[triangle];
+    const Vec3 normal = best.distance > 0 ? Vec3(offset / best.distance) : m_geometry->faceNormals[triangle];
     return detail::worldContact(m_motion, best.distance, normal, best.point);
   }
 
   // Pseudo-normal of the closest feature: vertex (one weight is 1), edge (one weight is 0), face.
   const Vec3& w = best.barycentric;
-  Vec3 pseudoNormal = m_faceNormals[triangle];
+  Vec3 pseudoNormal = m_geometry->faceNormals[triangle];
   for (Index k = 0; k < 3; ++k) {
     if (w[k] == 1) {
-      pseudoNormal = m_vertexNormals[m_indices[3 * triangle + k]];
+      pseudoNormal = m_geometry->vertexNormals[m_geometry->indices[3 * triangle + k]];
       break;
     }
     if (w[k] == 0) {
       // The edge opposite corner k runs from corner k+1 to corner k+2: edge slot (k + 1) % 3.
-      pseudoNormal = m_edgeNormals[3 * triangle + (k + 1) % 3];
+      pseudoNormal = m_geometry->edgeNormals[3 * triangle + (k + 1) % 3];
     }
   }
   const Real side = offset.dot(pseudoNormal) < 0 ? -1.0 : 1.0;
@@ -268,7 +270,7 @@ ShapeContact TriangleMeshShape::contactWith(const Vec3& local, Index triangle) c
 std::optional<Real> TriangleMeshShape::firstCrossing(const Vec3& start, const Vec3& end) const {
   const Vec3 a = m_motion.pose.toLocal(start);
   const Vec3 travel = m_motion.pose.toLocal(end) - a;
-  const std::vector<Bvh::Node>& nodes = m_localBvh.nodes();
+  const std::vector<Bvh::Node>& nodes = m_geometry->bvh.nodes();
   Real first = std::numeric_limits<Real>::infinity();
   Index stack[64];
   int top = 0;
@@ -281,8 +283,8 @@ std::optional<Real> TriangleMeshShape::firstCrossing(const Vec3& start, const Ve
       stack[top++] = node.first + 1;
       continue;
     }
-    for (Index t : m_localBvh.leafTriangles(node)) {
-      const Vec3* corner = &m_corners[3 * t];
+    for (Index t : m_geometry->bvh.leafTriangles(node)) {
+      const Vec3* corner = &m_geometry->corners[3 * t];
       const SegmentTriangleClosestPoints hit = closestPointsOnSegmentAndTriangle(
           a, a + travel, corner[0], corner[1], corner[2]);
       if (hit.distance == 0) first = std::min(first, hit.segmentParameter);
@@ -293,7 +295,7 @@ std::optional<Real> TriangleMeshShape::firstCrossing(const Vec3& start, const Ve
 }
 
 Aabb TriangleMeshShape::bounds() const {
-  const Aabb local = m_localBvh.bounds();
+  const Aabb local = m_geometry->bvh.bounds();
   Aabb box;
   for (int corner = 0; corner < 8; ++corner) {
     const Vec3 x((corner & 1) ? local.max.x() : local.min.x(),

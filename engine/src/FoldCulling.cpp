@@ -71,7 +71,8 @@ FoldCulling::FoldCulling(const ClothModel& model) : m_model(&model) {
   m_intervals.reserve(m_boundaryEdges.size());
 }
 
-bool FoldCulling::cannotTouchItself(const Vec3Array& start, const Vec3Array& end, Real thickness) {
+bool FoldCulling::cannotTouchItself(std::span<const Vec3> start, std::span<const Vec3> end,
+                                    Real thickness) {
   if (!m_applicable) return false;
   WEFT_PROFILE_ZONE("fold culling");
   const std::vector<Index>& indices = m_model->indices();

@@ -1,7 +1,7 @@
 // FoldCulling: decides, before a self-collision pass, that the pass cannot find anything, so it
 // can be skipped without changing a bit of the result.
 //
-// Design note. Self-collision (SelfCollision.h) acts only on pairs of features that share no
+// Design note. The contact detection acts only on pairs of features that share no
 // vertex and are closer than the thickness at the step start, or that meet during the step. A
 // cloth can produce such a pair only where it folds back over itself. The test below proves the
 // absence of folds in the manner of normal-cone culling (Volino & Magnenat-Thalmann 1994, "Efficient
@@ -34,6 +34,7 @@
 #include <weft/engine/ClothModel.h>
 
 #include <array>
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -46,7 +47,7 @@ class FoldCulling {
 
   /// True when a self-collision pass over the step start → end cannot find a pair closer than
   /// `thickness` nor a crossing (see the design note). No allocation after the first call.
-  bool cannotTouchItself(const Vec3Array& start, const Vec3Array& end, Real thickness);
+  bool cannotTouchItself(std::span<const Vec3> start, std::span<const Vec3> end, Real thickness);
 
   /// False when the model's shape rules the test out (then cannotTouchItself() is always false).
   bool applicable() const { return m_applicable; }

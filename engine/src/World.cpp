@@ -2,7 +2,7 @@
 
 #include "Cloth.h"
 #include "FrameCostModel.h"
-#include "ClothClothCollision.h"
+#include "SubstepPipeline.h"
 
 #include <weft/engine/InputFile.h>
 #include <weft/threading/Profiler.h>
@@ -49,6 +49,7 @@ const char* describe(HealthFailure failure) {
     case HealthFailure::Speed: return "speed";
     case HealthFailure::Strain: return "strain";
     case HealthFailure::EnergyJump: return "energy-jump";
+    case HealthFailure::OutOfRange: return "out-of-range";
   }
   return "unknown";
 }
@@ -57,7 +58,6 @@ struct World::ClothSlot {
   std::unique_ptr<Cloth> cloth;  // null when free
   std::uint32_t generation = 1;
   std::vector<ColliderAttachment> attachments;  // sorted by pinSlot
-  Real frameStrain = 0;  // the largest strain the cloth ended the last frame with
 };
 
 struct World::ColliderSlot {
@@ -141,60 +141,6 @@ std::string settingsProblem(const WorldSettings& settings) {
   return {};
 }
 
-// Every material, spring and mass value of `settings` within kMaxMaterialValue (signs, NaN and
-// infinity are Cloth::create's checks, with their own messages).
-Status checkMagnitudes(const ClothSettings& settings) {
-  const ClothMaterial& m = settings.material;
-  const MassSpringMaterial& s = settings.springs;
-  const struct {
-    const char* field;
-    Real value;
-    const char* unit;
-  } fields[] = {
-      {"material.arealDensity", m.arealDensity, "kg/m²"},
-      {"material.warpStretchStiffness", m.warpStretchStiffness, "N/m"},
-      {"material.weftStretchStiffness", m.weftStretchStiffness, "N/m"},
-      {"material.shearStiffness", m.shearStiffness, "N/m"},
-      {"material.bendingStiffness", m.bendingStiffness, "N·m"},
-      {"material.warpRestScale", m.warpRestScale, ""},
-      {"material.weftRestScale", m.weftRestScale, ""},
-      {"material.stretchDamping", m.stretchDamping, "N·s/m"},
-      {"material.shearDamping", m.shearDamping, "N·s/m"},
-      {"material.bendingDamping", m.bendingDamping, "N·m·s"},
-      {"material.airDrag", m.airDrag, "N·s/m³"},
-      {"material.thickness", m.thickness, "m"},
-      {"material.friction", m.friction, ""},
-      {"springs.structuralStiffness", s.structuralStiffness, "N/m"},
-      {"springs.shearStiffness", s.shearStiffness, "N/m"},
-      {"springs.flexionStiffness", s.flexionStiffness, "N/m"},
-      {"springs.structuralDamping", s.structuralDamping, "N·s/m"},
-      {"springs.shearDamping", s.shearDamping, "N·s/m"},
-      {"springs.flexionDamping", s.flexionDamping, "N·s/m"},
-      {"solver.selfContactStiffness", settings.solver.selfContactStiffness, ""},
-  };
-  auto tooLarge = [](const std::string& field, Real value, const char* unit) {
-    std::ostringstream text;
-    text << "cloth settings: " << field << " = " << value << (*unit ? " " : "") << unit
-         << " is above " << kMaxMaterialValue
-         << " (kMaxMaterialValue), the largest value whose products the solver's arithmetic "
-            "carries; give a physical value (a stiffer cloth is better made with "
-            "material.strainLimit)";
-    return Error{text.str()};
-  };
-  for (const auto& field : fields) {
-    if (std::isfinite(field.value) && field.value > kMaxMaterialValue) {
-      return tooLarge(field.field, field.value, field.unit);
-    }
-  }
-  for (std::size_t i = 0; i < settings.vertexMasses.size(); ++i) {
-    const Real mass = settings.vertexMasses[i];
-    if (std::isfinite(mass) && mass > kMaxMaterialValue) {
-      return tooLarge("vertexMasses[" + std::to_string(i) + "]", mass, "kg");
-    }
-  }
-  return Status::success();
-}
-
 // The first vector of `values` longer than `limit`, as an error "<name(k)> is (x, y, z) <unit>,
 // <comparison> <limit> <unit> (<why>)"; non-finite ones are the callee's check.
 template <typename Name>
@@ -244,7 +190,7 @@ World::World(const WorldSettings& settings)
     m_ownedTasks = std::make_unique<TaskSystem>(TaskSystemSettings{settings.threadCount});
     m_tasks = m_ownedTasks.get();
   }
-  m_clothContact = std::make_unique<ClothClothCollision>(m_tasks);
+  m_pipeline = std::make_unique<SubstepPipeline>(m_tasks, settings.skipUnneededStages);
 }
 
 std::uint64_t World::estimatedClothBytes(std::uint64_t vertices, std::uint64_t triangles) {
@@ -291,24 +237,7 @@ Error staleHandle(const char* operation, ClothId id) {
 Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
                                    const ClothSettings& settings) {
   if (!m_settingsError.empty()) return Error{m_settingsError};
-  if (Status magnitudes = checkMagnitudes(settings); !magnitudes.ok()) return magnitudes.error();
   if (model) {
-    // Where the vertices start: rest positions turned and moved by the settings (the pose
-    // itself is checked by Cloth::create).
-    if (settings.translation.allFinite() && settings.rotation.allFinite()) {
-      for (Index i = 0; i < model->vertexCount(); ++i) {
-        const Vec3 x = settings.rotation * model->restPositions()[i] + settings.translation;
-        if (!(x.cwiseAbs().maxCoeff() > kMaxCoordinate)) continue;
-        std::ostringstream text;
-        text << "cloth settings: translation (" << settings.translation.x() << ", "
-             << settings.translation.y() << ", " << settings.translation.z() << ") m puts vertex "
-             << i << " at (" << x.x() << ", " << x.y() << ", " << x.z() << ") m, beyond the "
-             << kMaxCoordinate
-             << " m a coordinate may have (kMaxCoordinate, where doubles still resolve 0.1 nm); "
-                "keep the simulation near the origin (move the origin with the player)";
-        return Error{text.str()};
-      }
-    }
     if (Status memory = checkMemory(estimatedClothBytes(model->vertexCount(), model->triangleCount()),
                                     "a cloth of " + std::to_string(model->vertexCount()) + " vertices",
                                     "use a coarser model");
@@ -319,6 +248,7 @@ Result<ClothId> World::createCloth(std::shared_ptr<const ClothModel> model,
   Result<std::unique_ptr<Cloth>> cloth =
       Cloth::create(std::move(model), settings, m_settings, m_tasks);
   if (!cloth.ok()) return cloth.error();
+  m_pipeline->clothsChanged();
   for (std::size_t k = 0; k < m_slots.size(); ++k) {
     if (!m_slots[k]->cloth) {
       m_slots[k]->cloth = std::move(cloth.value());
@@ -399,6 +329,7 @@ Status World::destroyCloth(ClothId id) {
   ClothSlot* slot = find(id);
   if (!slot) return staleHandle("destroyCloth", id);
   slot->cloth.reset();
+  m_pipeline->clothsChanged();
   slot->attachments.clear();
   ++slot->generation;  // every copy of the old handle is now stale
   return Status::success();
@@ -652,69 +583,24 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
   stats.frame = m_stats.frame + 1;
   stats.plan = plan;
   stats.budgetMs = budgetMs;
-  Index totalSubsteps = 0;
-  // Where the colliders are at the frame start; each cloth steps against them from there (a
-  // cloth poses the shapes per substep), and they end the frame advanced by their velocities.
-  m_colliderStartMotions.clear();
-  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (collider->shape) m_colliderStartMotions.push_back(motion(*collider->shape));
-  }
   updateAttachedPins(frameDt);
-  for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-    if (!slot->cloth) continue;
-    Cloth& cloth = *slot->cloth;
-    gatherColliderFrames(/*untilNow=*/false);
-    const ClothFrameReport report = cloth.stepFrame(m_time, frameDt, m_colliderFrames, plan);
-    stats.sleepingCloths += report.sleeping;
-    stats.wokenCloths += report.woke;
-    stats.teleportedCloths += report.teleported;
-    stats.colliderNarrowPhases += report.stages.colliderNarrowPhases;
-    stats.colliderNarrowPhasesSkipped += report.stages.colliderNarrowPhasesSkipped;
-    stats.selfCollisionPasses += report.stages.selfCollisionPasses;
-    stats.selfCollisionSkipped += report.stages.selfCollisionSkipped;
-    stats.bendingAssemblies += report.stages.bendingAssemblies;
-    stats.dampingJacobians += report.stages.dampingJacobians;
-    stats.bvhNodesRefit += report.stages.bvhNodesRefit;
-    stats.bvhNodesSkipped += report.stages.bvhNodesSkipped;
-    stats.frozenVertices += report.selfCollision.frozenVertices;
-    stats.strainLimitIterations += report.strainLimit.iterations;
-    stats.strainLimitEdgesOver += report.strainLimit.edgesOverLimit;
-    totalSubsteps += report.substeps;
-    stats.contacts += report.contacts;
-    stats.faceContacts += report.faceContacts;
-    stats.selfContacts += report.selfCollision.proximityContacts;
-    stats.selfImpacts += report.selfCollision.impacts;
-    stats.impactZones += report.selfCollision.impactZones;
-    stats.status |= report.status;
-    if (stats.healthFailure == HealthFailure::None) stats.healthFailure = report.healthFailure;
-    stats.substeps = std::max(stats.substeps, report.substeps);
-    stats.linearSolves += report.integrator.linearSolves;
-    stats.cgIterations += report.integrator.cgIterations;
-    stats.cgResidual = std::max(stats.cgResidual, report.integrator.cgResidual);
-    stats.potentialEnergy += report.integrator.potentialEnergy;
-    stats.assemblyMs += report.integrator.assemblyMs;
-    stats.solveMs += report.integrator.solveMs;
-    stats.solvedUnknowns += report.integrator.solvedUnknowns;
-    stats.kineticEnergy += report.kineticEnergy;
-    stats.maxStrain = std::max(stats.maxStrain, report.maxStrain);
-    slot->frameStrain = report.maxStrain;
-    stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
-  }
-  std::size_t k = 0;
+  // The colliders at the frame start; the pipeline poses its own copies per substep, and they
+  // end the frame advanced by their velocities.
+  m_colliderSources.clear();
   for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (!collider->shape) continue;
-    (void)setMotion(*collider->shape, advanceMotion(m_colliderStartMotions[k++], frameDt));
+    if (collider->shape) m_colliderSources.push_back({&*collider->shape, collider->settings.friction});
   }
-  collideCloths(frameDt, stats);
-  // A cloth that ends the frame past its limit + slack is reported, never passed off as ok.
+  m_steppedCloths.clear();
   for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-    if (!slot->cloth) continue;
-    const Real limit = slot->cloth->settings().material.strainLimit;
-    if (limit > 0 && std::isfinite(limit) && slot->frameStrain > limit + kStrainLimitSlack) {
-      ++stats.clothsOverStrainLimit;
-      stats.status |= StepStatus::StrainLimitExceeded;
+    if (slot->cloth) m_steppedCloths.push_back(slot->cloth.get());
+  }
+  m_pipeline->stepFrame(m_steppedCloths, m_colliderSources, m_time, frameDt, plan, stats);
+  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
+    if (collider->shape) {
+      (void)setMotion(*collider->shape, advanceMotion(motion(*collider->shape), frameDt));
     }
   }
+  const Index totalSubsteps = stats.substeps * (Index(m_steppedCloths.size()) - stats.sleepingCloths);
   m_time += frameDt;
   stats.simulatedTime = m_time;
   stats.stepMs =
@@ -724,44 +610,6 @@ StepStatus World::stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs
                       plan.cgTolerance > 0 ? plan.cgTolerance : defaultTolerance, costSmoothing);
   m_stats = stats;
   return stats.status;
-}
-
-void World::gatherColliderFrames(bool untilNow) {
-  m_colliderFrames.clear();
-  std::size_t k = 0;
-  for (const std::unique_ptr<ColliderSlot>& collider : m_colliderSlots) {
-    if (!collider->shape) continue;
-    ColliderFrame frame;
-    frame.shape = &*collider->shape;
-    frame.start = m_colliderStartMotions[k++];
-    frame.end = untilNow ? motion(*collider->shape) : frame.start;
-    frame.friction = collider->settings.friction;
-    m_colliderFrames.push_back(frame);
-  }
-}
-
-void World::collideCloths(Real frameDt, StepStats& stats) {
-  m_clothContact->beginFrame();
-  for (std::size_t k = 0; k < m_slots.size(); ++k) {
-    const ClothSlot& slot = *m_slots[k];
-    if (!slot.cloth || !slot.cloth->settings().collideWithOtherCloths) continue;
-    m_clothContact->addCloth(ClothId{std::uint32_t(k + 1), slot.generation}, slot.cloth.get());
-  }
-  // The colliders over the whole frame: from their start motions to where they are now.
-  gatherColliderFrames(/*untilNow=*/true);
-  const SelfCollisionReport report = m_clothContact->resolveFrame(frameDt, m_colliderFrames);
-  if (report.proximityContacts + report.impacts + report.impactZones > 0) {
-    // The pass moved vertices after the cloths measured their strain: the frame ends here.
-    stats.maxStrain = 0;
-    for (const std::unique_ptr<ClothSlot>& slot : m_slots) {
-      if (!slot->cloth) continue;
-      slot->frameStrain = slot->cloth->maxStrain();
-      stats.maxStrain = std::max(stats.maxStrain, slot->frameStrain);
-    }
-  }
-  stats.clothContacts += report.proximityContacts;
-  stats.clothImpacts += report.impacts;
-  stats.clothImpactZones += report.impactZones;
 }
 
 Result<ClothRenderView> World::renderView(ClothId id) const {

@@ -76,6 +76,13 @@ class Reader {
   bool full() const { return m_issues.size() >= m_options.maxIssues; }
   std::size_t issueCount() const { return m_issues.size(); }
 
+  // Reports `key` of `object`, a key the format no longer has, with what replaced it.
+  void removedKey(const Json& object, const std::string& path, const char* key, const char* why) {
+    if (object.is_object() && object.contains(key)) {
+      fail(child(path, key), std::string("\"") + key + "\" no longer exists: " + why);
+    }
+  }
+
   // Reports keys of `object` that are not in `allowed`.
   void checkKeys(const Json& object, const std::string& path,
                  std::initializer_list<std::string_view> allowed) {
@@ -400,6 +407,7 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   if (!reader.expectObject(object, path, "solver settings")) return;
   reader.checkKeys(object, path,
                    {"integrator", "substeps", "maxImplicitStep", "maxSubsteps", "maxPinTravelPerSubstep",
+                    "strainRetrySubsteps",
                     "pinTeleportDistance", "pinTeleportAngle", "newtonIterations", "tightCgTolerance",
                     "tightSelfContactDensity", "tightPinTravel", "cgTolerance", "cgStopping",
                     "cgMaxIterations", "warmStart", "selfContactStiffness"});
@@ -421,13 +429,14 @@ void readSolver(Reader& reader, const Json& object, const std::string& path, Sol
   reader.readInteger(object, path, "substeps", s.substeps, 0, 100000);
   reader.readReal(object, path, "maxImplicitStep", s.maxImplicitStep, Range::Positive, "s");
   reader.readInteger(object, path, "maxSubsteps", s.maxSubsteps, 1, 1000000);
+  reader.readInteger(object, path, "strainRetrySubsteps", s.strainRetrySubsteps, 0, 1000000);
   reader.readReal(object, path, "maxPinTravelPerSubstep", s.maxPinTravelPerSubstep, Range::NonNegative,
                   "mean edge lengths");
   reader.readReal(object, path, "pinTeleportDistance", s.pinTeleportDistance, Range::NonNegative,
                   "cloth sizes");
   reader.readReal(object, path, "pinTeleportAngle", s.pinTeleportAngle, Range::NonNegative, "rad");
-  readMaterialValue(reader, object, path, "selfContactStiffness", s.selfContactStiffness, Range::NonNegative,
-                  "multiples of the stretch stiffness");
+  reader.readReal(object, path, "selfContactStiffness", s.selfContactStiffness, Range::NonNegative,
+                  "multiples of the stretch stiffness, 0 = off");
   reader.readInteger(object, path, "newtonIterations", s.newtonIterations, 0, 100);
   reader.readReal(object, path, "tightCgTolerance", s.tightCgTolerance, Range::NonNegative,
                   "relative residual, 0 = off");
@@ -574,10 +583,12 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
                                           const std::string& path, std::size_t index,
                                           std::vector<PendingAttachment>& attachments) {
   if (!reader.expectObject(object, path, "a cloth")) return std::nullopt;
+  reader.removedKey(object, path, "jointContactProjection",
+                    "collider contacts, self-contacts and the strain limit are projected together "
+                    "in every substep; delete the key");
   reader.checkKeys(object, path,
                    {"name", "grid", "mesh", "translation", "rotation", "forceModel", "material",
-                    "springs", "solver", "selfCollision", "faceContacts", "jointContactProjection",
-                    "initialPleats", "pins"});
+                    "springs", "solver", "selfCollision", "faceContacts", "initialPleats", "pins"});
   ClothDescription cloth;
   cloth.name = "cloth " + std::to_string(index);
   reader.readString(object, path, "name", cloth.name);
@@ -649,7 +660,6 @@ std::optional<ClothDescription> readCloth(Reader& reader, const Json& object,
   if (const Json* solver = Reader::member(object, "solver")) readSolver(reader, *solver, child(path, "solver"), settings.solver);
   reader.readBool(object, path, "selfCollision", settings.selfCollision);
   reader.readBool(object, path, "faceContacts", settings.faceContacts);
-  reader.readBool(object, path, "jointContactProjection", settings.jointContactProjection);
 
   if (const Json* pleats = Reader::member(object, "initialPleats")) {
     const std::string here = child(path, "initialPleats");

@@ -54,6 +54,33 @@ TEST(CoplanarityCubic, HandlesDoubleRootsLinearAndConstantCases) {
   EXPECT_TRUE(hasTimeNear(detail::cubicCandidateTimes(Cubic{0, 1, 0, 0}, 1e-15), 0.0, 0));
 }
 
+TEST(CoplanarityCubic, ACubicThatComesWithinTheSlackOfZeroAlwaysHasACandidate) {
+  // Random cubics, many of them grazing zero on [0, 1] (a dip placed at a random time): whenever
+  // a fine sampling finds |f| within the slack or a change of sign, there must be candidates;
+  // the Bernstein bound that skips the rest may never skip one of these.
+  std::mt19937_64 random(7);
+  std::uniform_real_distribution<Real> coefficient(-1, 1), time(0, 1);
+  const Real slack = 1e-6;
+  int grazing = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    // f(t) = a (t − r)² (t − s) + d, with d small so that many cubics pass close to zero.
+    const Real a = coefficient(random), r = time(random), s = 1 + 2 * time(random);
+    const Real d = 1e-3 * coefficient(random);
+    const Cubic f{-a * r * r * s + d, a * (r * r + 2 * r * s), -a * (2 * r + s), a};
+    bool touches = false;
+    for (int k = 0; k <= 4000 && !touches; ++k) {
+      const Real t = k / 4000.0;
+      touches = std::abs(f(t)) <= slack || (k > 0 && (f(t) < 0) != (f((k - 1) / 4000.0) < 0));
+    }
+    grazing += touches;
+    if (touches) {
+      EXPECT_GT(detail::cubicCandidateTimes(f, slack).count, 0)
+          << "f = " << f.c0 << " + " << f.c1 << " t + " << f.c2 << " t² + " << f.c3 << " t³";
+    }
+  }
+  EXPECT_GT(grazing, 1000);  // the draw exercises the case it is about
+}
+
 TEST(CoplanarityCubic, ReportsTheLeftEndOfTheBracket) {
   // The reported time is never after the crossing.
   const Real root = 1.0 / 3.0;

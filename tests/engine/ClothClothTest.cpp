@@ -1,4 +1,5 @@
-// Contact between different cloths of one World (ClothClothCollision): layers that fall on each
+// Contact between different cloths of one World (pairs between cloths in the one contact set):
+// layers that fall on each
 // other onto a floor and onto a sphere, a fast layer thrown at a pinned sheet, layers stepped
 // with different substep counts. In every frame no two triangles intersect, within a cloth or
 // between cloths (exact triangle–triangle test), and no vertex is inside a collider.

@@ -1,10 +1,11 @@
-// Cloth faces against round colliders (ColliderFaceContacts): a face with a sphere between its
-// vertices is pushed out along the contact normal by exactly the depth, pins stay, the face's
-// approach velocity goes; a face that crossed the core within the step goes back to the side it
-// came from; and a sheet dropped on a rod thinner than its triangles hangs on it, where with
-// vertex contacts alone the rod passes between the vertices and the sheet falls through.
-#include "ColliderFaceContacts.h"
+// Cloth faces against bodies thinner than the triangles (face contacts, engine/src/contact/
+// FaceCores.h): a sheet dropped on a rod, a plank or a mesh plank hangs on it, where with vertex
+// contacts alone the body passes between the vertices and the sheet falls through; a towel resting
+// on a rod by its faces stays on it without riding along it. The kernels are tested in
+// ContactProjectorTest.
 #include "ContactTestSupport.h"
+#include "contact/ContactDetector.h"
+#include "contact/ContactProjector.h"
 
 #include <weft/collision/Proximity.h>
 #include <weft/collision/TriangleMeshShape.h>
@@ -20,133 +21,6 @@ namespace weft {
 namespace {
 
 using test::horizontalSquare;
-
-// One horizontal triangle, 0.3 m on its legs, at height `height`, its centroid over the origin.
-std::array<TriangleRest, 1> oneTriangle(Vec3Array& x, Real height) {
-  x = {Vec3(-0.1, height, -0.1), Vec3(0.2, height, -0.1), Vec3(-0.1, height, 0.2)};
-  TriangleRest triangle;
-  triangle.vertices = {0, 1, 2};
-  return {triangle};
-}
-
-// Distance from the sphere's centre (the origin) to the triangle, minus nothing: the face's gap
-// to the core.
-Real coreDistance(const Vec3Array& x) {
-  return closestPointOnTriangle(Vec3::Zero(), x[0], x[1], x[2]).distance;
-}
-
-// The contact thickness Cloth passes as the allowance.
-constexpr Real kAllowance = 0.003;
-
-// One resolve() of `faces` against the single body `shape`, at rest at its pose.
-ColliderFaceReport resolveAgainst(ColliderFaceContacts& faces, Shape& shape,
-                                  std::span<const TriangleRest> triangles, const Vec3Array& xStart,
-                                  std::span<const Real> inverseMasses, Real allowance, Vec3Array& x,
-                                  Vec3Array& v) {
-  const ColliderFrame collider{&shape, motion(shape), motion(shape), 0.3};
-  return faces.resolve(std::span<const ColliderFrame>(&collider, 1), triangles, xStart,
-                       inverseMasses, allowance, x, v);
-}
-
-TEST(ColliderFaceContacts, PushesAFaceOutOfASphereBetweenItsVertices) {
-  // A 5 cm ball under the middle of the face, 2 cm into it; every vertex is far outside it.
-  Shape ball = Sphere::create(0.05).value();
-  Vec3Array x, v(3, Vec3(0, -1, 0));
-  const auto triangles = oneTriangle(x, 0.03);
-  const Vec3Array xStart = {x[0] + Vec3(0, 0.1, 0), x[1] + Vec3(0, 0.1, 0), x[2] + Vec3(0, 0.1, 0)};
-  const std::vector<Real> inverseMasses{1, 1, 1};
-  const Real allowance = kAllowance;
-  ColliderFaceContacts faces;
-  const ColliderFaceReport report =
-      resolveAgainst(faces, ball, triangles, xStart, inverseMasses, allowance, x, v);
-  EXPECT_EQ(report.contacts, 1);
-  // Out to the radius less the allowance, straight up (the face is level over the centre).
-  EXPECT_NEAR(coreDistance(x), 0.05 - allowance, 1e-12);
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(x[k].y(), x[0].y(), 1e-12) << "vertex " << k;
-  // No velocity into the ball is left; nothing was added along the face.
-  for (int k = 0; k < 3; ++k) {
-    EXPECT_NEAR(v[k].y(), 0, 1e-12) << "vertex " << k;
-    EXPECT_NEAR(v[k].x(), 0, 1e-12);
-    EXPECT_NEAR(v[k].z(), 0, 1e-12);
-  }
-  // The limiter's hold keeps the same face point at the same height.
-  ASSERT_EQ(faces.holds().size(), 1u);
-  const SeparationHold& hold = faces.holds()[0];
-  const Vec3 point = hold.weights[0] * x[hold.vertices[0]] + hold.weights[1] * x[hold.vertices[1]] +
-                     hold.weights[2] * x[hold.vertices[2]];
-  EXPECT_NEAR(hold.normal.dot(point), hold.separation, 1e-12);
-  EXPECT_GT(hold.normal.y(), 0.999);
-}
-
-TEST(ColliderFaceContacts, PinnedCornersStayAndTheOthersTakeTheCorrection) {
-  Shape ball = Sphere::create(0.05).value();
-  Vec3Array x, v(3, Vec3::Zero());
-  const auto triangles = oneTriangle(x, 0.03);
-  const Vec3Array xStart = x;
-  const Vec3 pinned = x[0];
-  const std::vector<Real> inverseMasses{0, 1, 1};
-  ColliderFaceContacts faces;
-  (void)resolveAgainst(faces, ball, triangles, xStart, inverseMasses, 0.0, x, v);
-  EXPECT_EQ(x[0], pinned);
-  EXPECT_NEAR(coreDistance(x), 0.05, 1e-6);  // swept a few times: the tilted face settles
-  // All three pinned: nothing can move, nothing is done.
-  Vec3Array still;
-  const auto again = oneTriangle(still, 0.03);
-  const Vec3Array before = still;
-  const std::vector<Real> allPinned{0, 0, 0};
-  const ColliderFaceReport none =
-      resolveAgainst(faces, ball, again, before, allPinned, 0.0, still, v);
-  EXPECT_EQ(none.contacts, 0);
-  EXPECT_EQ(still, before);
-}
-
-TEST(ColliderFaceContacts, AFaceThatCrossedTheCoreGoesBackToTheSideItCameFrom) {
-  // The face started 1 cm above the centre of a 5 cm ball and ended 1 cm below it (its vertices
-  // are outside the ball throughout): its own normal at the end points down, through the ball.
-  Shape ball = Sphere::create(0.05).value();
-  Vec3Array x, v(3, Vec3(0, -1.2, 0)), xStart;
-  (void)oneTriangle(xStart, 0.01);
-  const auto triangles = oneTriangle(x, -0.01);
-  const std::vector<Real> inverseMasses{1, 1, 1};
-  ColliderFaceContacts faces;
-  const ColliderFaceReport report =
-      resolveAgainst(faces, ball, triangles, xStart, inverseMasses, 0.0, x, v);
-  EXPECT_EQ(report.contacts, 1);
-  EXPECT_NEAR(x[0].y(), 0.05, 1e-12);  // above the ball, where it came from
-  EXPECT_NEAR(v[0].y(), 0, 1e-12);
-}
-
-TEST(ColliderFaceContacts, ACapsuleMovingThroughAFaceIsFollowedInItsFrame) {
-  // A rod (capsule along x) rising 3 cm in the step into a face 2 cm above its axis; the face
-  // is pushed up with the rod, to the radius, and takes the rod's upward speed.
-  RigidMotion start;
-  start.pose.rotation = Quat::FromTwoVectors(Vec3::UnitY(), Vec3::UnitX());
-  start.linearVelocity = Vec3(0, 1.8, 0);
-  RigidMotion end = start;
-  end.pose.position = Vec3(0, 0.03, 0);
-  Shape rod = Capsule::create(0.02, 0.5, end).value();
-  const ColliderFrame collider{&rod, start, end, 0.3};
-  Vec3Array x, v(3, Vec3::Zero());
-  const auto triangles = oneTriangle(x, 0.02);
-  const Vec3Array xStart = x;
-  const std::vector<Real> inverseMasses{1, 1, 1};
-  ColliderFaceContacts faces;
-  const ColliderFaceReport report = faces.resolve(std::span<const ColliderFrame>(&collider, 1),
-                                                  triangles, xStart, inverseMasses, 0.0, x, v);
-  EXPECT_EQ(report.contacts, 1);
-  // On the rod's surface, on the side the face came from (above its axis), and carried up: the
-  // face point of the last contact leaves with the rod (the corners' speeds differ; the face
-  // tilted as it was pushed).
-  const SegmentTriangleClosestPoints gap =
-      closestPointsOnSegmentAndTriangle(Vec3(-0.5, 0.03, 0), Vec3(0.5, 0.03, 0), x[0], x[1], x[2]);
-  // Pushed across the rod at the two ends of the axis's part under the face, one after the other,
-  // each exact at its own point: the second lifts the first a little past the radius (0.15 mm).
-  EXPECT_GE(gap.distance, 0.02 - 1e-9);
-  EXPECT_LT(gap.distance, 0.02 + 5e-4);
-  for (int k = 0; k < 3; ++k) EXPECT_GT(x[k].y(), 0.03) << "vertex " << k;
-  for (int k = 0; k < 3; ++k) EXPECT_GE(v[k].y(), 0) << "vertex " << k;
-  EXPECT_GT(v[0].y() + v[1].y() + v[2].y(), 1.8);
-}
 
 // A 0.5 m cotton square (11 × 11 vertices, 5 cm edges) dropped from 10 cm onto a horizontal rod
 // of 2 cm radius under its middle, a little off its centre line. Returns the lowest height of
@@ -298,26 +172,43 @@ TEST(ColliderFaceContacts, AreBitwiseTheSameOnOneAndTwoThreads) {
 
 TEST(ColliderFaceContacts, ABoxEdgeThatCrossedAFaceIsPutBackOnTheSideTheFaceCameFrom) {
   // A box whose top edges run along z at x = ±0.02, y = 0.02; the face started 1 cm above them
-  // and ended 1 cm below their height (all its corners outside the box: it is much wider).
-  Shape box = Box::create(Vec3(0.02, 0.02, 0.5)).value();
-  Vec3Array x, v(3, Vec3(0, -1.2, 0)), xStart;
-  (void)oneTriangle(xStart, 0.03);
-  const auto triangles = oneTriangle(x, 0.01);
-  const std::vector<Real> inverseMasses{1, 1, 1};
-  const Real allowance = kAllowance;
-  ColliderFaceContacts faces;
-  const ColliderFaceReport report =
-      resolveAgainst(faces, box, triangles, xStart, inverseMasses, allowance, x, v);
-  EXPECT_GE(report.contacts, 1);
+  // and ended 1 cm below their height (all its corners outside the box: it is much wider). The
+  // detection finds the crossing, the projection puts the face back.
+  constexpr Real kAllowance = 0.003;
+  ColliderFrame collider;
+  collider.shape = Box::create(Vec3(0.02, 0.02, 0.5)).value();
+  collider.start = collider.end = motion(collider.shape);
+  auto triangle = [](Real height) {
+    return Vec3Array{Vec3(-0.1, height, -0.1), Vec3(0.2, height, -0.1), Vec3(-0.1, height, 0.2)};
+  };
+  ContactSpace space;
+  space.x = triangle(0.01);
+  space.startX = triangle(0.03);
+  space.v = space.startV = Vec3Array(3, Vec3(0, -1.2, 0));
+  space.inverseMass = {1, 1, 1};
+  space.owner = {0, 0, 0};
+  space.owners = {ContactOwner{kAllowance, 0.3, false, false}};
+  space.triangles = {{0, 1, 2}};
+  ContactDetector detector;
+  ContactSet set;
+  DetectionCounts counts;
+  detector.detect(space, std::span<const ColliderFrame>(&collider, 1), {}, {}, false, 0, set, counts);
+  Index faces = 0;
+  for (const Contact& contact : set.contacts) faces += contact.kind == ContactKind::FaceCollider;
+  EXPECT_GE(faces, 1u);
+  ContactProjector projector;
+  std::vector<FaceSupport> supports;
+  (void)projector.project(space, set, std::span<const ColliderFrame>(&collider, 1), 1.0 / 60, {},
+                          supports);
   // Back above the top edges, by half the allowance (edges have no radius), and no longer moving
   // down.
   for (Real edgeX : {-0.02, 0.02}) {
     const SegmentTriangleClosestPoints gap = closestPointsOnSegmentAndTriangle(
-        Vec3(edgeX, 0.02, -0.5), Vec3(edgeX, 0.02, 0.5), x[0], x[1], x[2]);
-    EXPECT_GT(gap.distance, 0.5 * allowance - 1e-6) << "edge at x = " << edgeX;
+        Vec3(edgeX, 0.02, -0.5), Vec3(edgeX, 0.02, 0.5), space.x[0], space.x[1], space.x[2]);
+    EXPECT_GT(gap.distance, 0.5 * kAllowance - 1e-6) << "edge at x = " << edgeX;
     EXPECT_GT(gap.pointOnTriangle.y(), gap.pointOnSegment.y()) << "edge at x = " << edgeX;
   }
-  EXPECT_GE(v[0].y() + v[1].y() + v[2].y(), -1e-12);
+  EXPECT_GE(space.v[0].y() + space.v[1].y() + space.v[2].y(), -1e-9);
 }
 
 }  // namespace

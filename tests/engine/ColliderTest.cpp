@@ -57,12 +57,10 @@ TEST(Collider, ClothDropsOntoASphereAndRestsOnIt) {
       EXPECT_LT(lateEnergy / 30, 2e-3);
     }
   }
-  // Resting: the centre stays on top for the 5 s. Until 2026-11-23 a known engine failure:
-  // friction acted on velocities only, so a contact that sticks had still moved h v_t in the
-  // solve, and the drape crept off (the centre 1 cm below the top from frame 98 to 199 by
-  // solver tolerance, off the sphere by frame ~205-310). Friction now moves positions too
-  // (ColliderResponse::resolve's positionStep) and is bounded by the solve's contact impulse
-  // (DynamicSystem::receiveContactImpulses): see ColliderResponse.h.
+  // Resting: the centre stays on top for the 5 s. Friction that acted on velocities only would
+  // let a sticking contact move h v_t in the solve and the drape creep off; the contact
+  // projection's friction moves positions, bounded by the normal separation and the solve's
+  // contact impulse (DynamicSystem::receiveContactImpulses).
   EXPECT_TRUE(landed) << "the centre never reached the top of the sphere";
   EXPECT_EQ(leftTheTop, -1) << "the drape's centre left the top (more than 1 cm off it) at frame "
                             << leftTheTop;

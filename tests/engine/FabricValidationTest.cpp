@@ -10,7 +10,6 @@
 
 #include <gtest/gtest.h>
 
-#include "engine/KnownEngineFailure.h"
 
 #include <algorithm>
 #include <cmath>
@@ -83,18 +82,13 @@ TEST_P(FabricPreset, CusickDrapeSettlesWithinThreeSeconds) {
   // Released flat with the engine's defaults, the hem stops creeping: by 3 s it moves slower than
   // 2 mm/s and the drape coefficient changes by less than 0.005 over the last half second (the
   // drapemeter's own reading error is about ±0.02). A drape coefficient lies in (0, 1).
-  // Known engine failure: denim's hem still creeps faster than 2 mm/s at 3 s.
   const DrapeResult result = drape(GetParam(), 0.0075, 1, 3.0);
   RecordProperty("drape_coefficient", std::to_string(result.coefficient));
   EXPECT_NEAR(result.coefficient, result.coefficientBefore, 0.005) << GetParam();
   EXPECT_GT(result.coefficient, 0) << GetParam();
   EXPECT_LT(result.coefficient, 1) << GetParam();
-  if (GetParam() == "denim") {
-    test::knownEngineFailure(result.hemSpeed < 0.002, "denim's hem settles below 2 mm/s by 3 s",
-                             "hem speed " + std::to_string(1000 * result.hemSpeed) + " mm/s");
-  } else {
-    EXPECT_LT(result.hemSpeed, 0.002) << GetParam();
-  }
+  EXPECT_LT(result.hemSpeed, 0.002) << GetParam() << ": hem speed " << 1000 * result.hemSpeed
+                                     << " mm/s at 3 s";
 }
 
 TEST(Cantilever, DenimBendsWithinItsPublishedBendingLength) {

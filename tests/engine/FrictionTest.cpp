@@ -1,12 +1,8 @@
-// Coulomb friction of the collider response: the pure kernel (static and kinetic), and a point
-// on an incline stepped as a cloth vertex is (symplectic Euler, then the response pass): below
-// the friction angle it sticks, and does not creep when friction's velocity change moves the
-// position too (ColliderResponse::resolve's positionStep; velocity-level friction alone lets it
-// creep h² a_t per step, the cause of the drape sliding off the sphere in ColliderTest); above
-// the friction angle it slides at g(sin θ − μ cos θ). The same for a whole cloth stepped by a
-// World, and the contact constraint of the solve on a grazing path.
-#include "ColliderResponse.h"
+// Coulomb friction: the pure kernel (static and kinetic); a whole cloth on an incline stepped by a
+// World sticks below the friction angle and slides at g(sin θ − μ cos θ) above it (the projector's
+// own test steps a single point); and the contact constraint of the solve on a grazing path.
 #include "ContactTestSupport.h"
+#include "contact/ContactDetector.h"
 
 #include <weft/collision/Plane.h>
 #include <weft/collision/Sphere.h>
@@ -36,60 +32,6 @@ TEST(CoulombFriction, SlidesWithTheKineticLossOutsideTheCone) {
   // No friction, or no impulse, keeps it all.
   EXPECT_EQ(coulombFriction(tangential, 1.0, 0.0), tangential);
   EXPECT_EQ(coulombFriction(tangential, 0.0, 0.3), tangential);
-}
-
-// A point on a plane through the origin tilted by `angle` about z, stepped `steps` times by
-// symplectic Euler under gravity and then the response pass, as a cloth's step does. Returns
-// its displacement along the plane.
-Real slideOnIncline(Real angle, Real friction, int steps, Real h, bool movePositions) {
-  const Vec3 normal(-std::sin(angle), std::cos(angle), 0);
-  Shape plane = Plane::create(normal).value();
-  const ColliderFrame collider{&plane, RigidMotion{}, RigidMotion{}, friction};
-  const Real thickness = 0.003;
-  const Vec3 gravity(0, -9.81, 0);
-  Vec3Array x{Vec3(thickness * normal)}, v{Vec3::Zero()}, xStart, vStart;
-  const std::vector<char> pinned{0};
-  const ColliderResponse response;
-  for (int step = 0; step < steps; ++step) {
-    xStart = x;
-    vStart = v;
-    v[0] += h * gravity;
-    x[0] += h * v[0];
-    const ColliderResponseReport report = response.resolve(
-        std::span<const ColliderFrame>(&collider, 1), xStart, vStart, thickness, pinned, x, v,
-        nullptr, /*friction=*/true, /*positionStep=*/movePositions ? h : 0);
-    EXPECT_EQ(report.contacts, 1) << "step " << step;
-  }
-  const Vec3 moved = x[0] - thickness * normal;
-  return (moved - moved.dot(normal) * normal).norm();
-}
-
-TEST(CoulombFriction, APointBelowTheFrictionAngleStaysPut) {
-  // tan 10° = 0.18 < μ = 0.3: static friction holds it for 5 s of 1/240 s steps.
-  const Real angle = 10 * M_PI / 180;
-  EXPECT_LT(slideOnIncline(angle, 0.3, 1200, 1.0 / 240, /*movePositions=*/true), 1e-12);
-  // Friction on the velocity alone (what Cloth's step does today) lets it creep h² g sin θ a
-  // step although it sticks: 5 s × (1/240 s) × 1.70 m/s² = 3.5 cm.
-  const Real crept = slideOnIncline(angle, 0.3, 1200, 1.0 / 240, /*movePositions=*/false);
-  EXPECT_NEAR(crept, 5.0 / 240 * 9.81 * std::sin(angle), 0.001);
-}
-
-TEST(CoulombFriction, APointAboveTheFrictionAngleSlidesAtTheKineticRate) {
-  // tan 30° = 0.58 > μ = 0.3: v gains h a a step, a = g (sin θ − μ cos θ) = 2.36 m/s². With
-  // x = x₀ + h v after friction it goes h² a N(N + 1)/2 in N steps: ½ a t² (1 + 1/N), 1.18 m in
-  // 1 s.
-  const Real angle = 30 * M_PI / 180, friction = 0.3, h = 1.0 / 240, g = 9.81;
-  const int steps = 240;
-  const Real acceleration = g * (std::sin(angle) - friction * std::cos(angle));
-  EXPECT_NEAR(slideOnIncline(angle, friction, steps, h, true),
-              0.5 * acceleration * (1 + 1.0 / steps), 1e-9);
-  // Frictionless: a = g sin θ.
-  EXPECT_NEAR(slideOnIncline(angle, 0.0, steps, h, true),
-              0.5 * g * std::sin(angle) * (1 + 1.0 / steps), 1e-9);
-  // With velocity-level friction alone each step moves with the velocity before friction,
-  // h (v + h g sin θ): ½ a t² (1 − 1/N) + h t g sin θ, 1.4 cm further in this second.
-  EXPECT_NEAR(slideOnIncline(angle, friction, steps, h, false),
-              0.5 * acceleration * (1 - 1.0 / steps) + h * g * std::sin(angle), 1e-9);
 }
 
 // A 30 cm cloth laid on a plane through the origin tilted by `degrees` about z (air drag off),
@@ -135,29 +77,34 @@ TEST(CoulombFriction, AClothBelowTheFrictionAngleStaysPutAndAboveItSlidesAtTheKi
 TEST(ColliderConstraint, AGrazingPathOverACurvedBodyIsNotConstrained) {
   // A vertex on top of a 15 cm sphere that moves sideways by 6.7 cm in the step (4 m/s at
   // 1/60 s): relative to the body it slides off the top and ends clear. The tangent plane at the
-  // point where its path first came near put it inside, and the solve then held it there
-  // against the cloth's tension (an impulse of 36 m/s in the withdrawing-sphere scene of
-  // ColliderSlidingTest, where the end was 1.7 cm clear and the plane said 0.5 mm inside).
+  // point where its path first came near would put it inside, and the solve would then hold it
+  // there against the cloth's tension.
   const Real h = 1.0 / 60, thickness = 0.003, radius = 0.15;
   RigidMotion start;
   start.linearVelocity = Vec3(0, 0, -4);
   const RigidMotion end = advanceMotion(start, h);
-  Shape sphere = Sphere::create(radius, end).value();
-  const ColliderFrame collider{&sphere, start, end, 0.3};
+  ColliderFrame collider;
+  collider.shape = Sphere::create(radius, end).value();
+  collider.start = start;
+  collider.end = end;
   // 2 cm behind the top, 0.3 mm above it: relative to the body its path passes over the top,
-  // where it comes within half its start distance (1.6 mm; the hit), and ends 7 mm clear.
-  const Vec3Array x{Vec3(0, radius + 0.0003, -0.02)}, v{Vec3::Zero()};
-  const std::vector<char> pinned{0};
-  VertexFilter filter;
-  filter.resize(1);
-  ColliderResponse response;
-  EXPECT_EQ(response.constrain(std::span<const ColliderFrame>(&collider, 1), x, v, h, thickness,
-                               pinned, filter), 0);
+  // where it comes within half its start distance (the hit), and ends 7 mm clear.
+  ContactSpace space;
+  space.x = space.startX = {Vec3(0, radius + 0.0003, -0.02)};
+  space.v = space.startV = {Vec3::Zero()};
+  space.inverseMass = {1};
+  space.owner = {0};
+  space.owners = {ContactOwner{thickness, 0.3, false, false}};
+  ContactDetector detector;
+  DetectionCounts counts;
+  std::vector<SolveConstraint> constraints;
+  detector.constrain(space, std::span<const ColliderFrame>(&collider, 1), h, {}, constraints, counts);
+  EXPECT_TRUE(constraints.empty());
   // Coming down into it (3 m/s: 3.6 cm inside at the end of the step) is constrained.
-  const Vec3Array falling{Vec3(0, -3, 0)};
-  ASSERT_EQ(response.constrain(std::span<const ColliderFrame>(&collider, 1), x, falling, h,
-                               thickness, pinned, filter), 1);
-  EXPECT_EQ(filter.kind(0), ConstraintKind::OneDirection);
+  space.startV = {Vec3(0, -3, 0)};
+  detector.constrain(space, std::span<const ColliderFrame>(&collider, 1), h, {}, constraints, counts);
+  ASSERT_EQ(constraints.size(), 1u);
+  EXPECT_GT(constraints[0].normal.y(), 0.9);
 }
 
 }  // namespace

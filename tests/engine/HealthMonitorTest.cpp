@@ -1,5 +1,6 @@
 // The health monitor names why a frame failed (StepStats::healthFailure), never lets a NaN out,
 // and reports nothing on healthy frames.
+#include <weft/collision/Sphere.h>
 #include <weft/engine/World.h>
 
 #include <gmock/gmock.h>
@@ -31,6 +32,7 @@ TEST(HealthMonitor, NamesEveryCause) {
   EXPECT_STREQ(describe(HealthFailure::Speed), "speed");
   EXPECT_STREQ(describe(HealthFailure::Strain), "strain");
   EXPECT_STREQ(describe(HealthFailure::EnergyJump), "energy-jump");
+  EXPECT_STREQ(describe(HealthFailure::OutOfRange), "out-of-range");
 }
 
 TEST(HealthMonitor, ADivergingFrameIsRolledBackWithItsCause) {
@@ -79,6 +81,24 @@ TEST(HealthMonitor, AFastButPhysicalThrowIsNotAFailure) {
   for (int frame = 0; frame < 10; ++frame) {
     ASSERT_EQ(world.step(1.0 / 60.0), StepStatus::Ok) << describe(world.stats().healthFailure);
   }
+}
+
+TEST(HealthMonitor, AClothCarriedBeyondTheSimulatedRangeIsRolledBack) {
+  // One frame of 1e308 s (BadInput's clock test) carries a pinned sheet far beyond 1e9 m
+  // (kMaxSimulatedCoordinate), where doubles cannot resolve its thickness: the attempt fails at
+  // its first substep, instead of testing every pair of triangles in thousands of substeps, and
+  // the frame is rolled back with its cause; the cloth is where it was.
+  World world;
+  const ClothId cloth = world.createCloth(smallGrid(), pinnedTopRow()).value();
+  (void)world.addCollider(Sphere::create(0.1, RigidMotion{{Vec3(0, 0, -1)}}).value()).value();
+  for (int frame = 0; frame < 3; ++frame) ASSERT_EQ(world.step(1.0 / 60.0), StepStatus::Ok);
+  const std::uint64_t before = world.stateHash();
+  const StepStatus status = world.step(1e308);
+  EXPECT_TRUE(hasFlag(status, StepStatus::RolledBack)) << describe(status);
+  EXPECT_EQ(world.stats().healthFailure, HealthFailure::OutOfRange)
+      << describe(world.stats().healthFailure);
+  EXPECT_EQ(world.stateHash(), before);
+  for (const Vec3& x : world.positions(cloth).value()) ASSERT_TRUE(x.allFinite());
 }
 
 }  // namespace

@@ -119,7 +119,7 @@ TEST(PinTeleport, ANegativeOrNonFinitePinTravelIsRefusedByName) {
 }
 
 TEST(PinTeleport, ClothDraggedTenMetresFollowsWithinItsStrainLimit) {
-  // Self-collision off: this is about the solve and the strain limiter following the pins. Awake
+  // Self-collision off: this is about the solve and the strain limit following the pins. Awake
   // (sleep off), so the cloth starts the jump with the small motions of a hanging sheet. The
   // teleport rule is off, so the pins drag the cloth.
   ClothSettings settings = draggedCotton();

@@ -1,9 +1,8 @@
 // Self-contacts inside the implicit solve (SolverSettings::selfContactStiffness): the corner
-// crumple of CollisionScenesTest, whose pile keeps stirring when the solve ignores the contacts
-// the self-collision pass then restores (tests/README.md, "why a crumpled pile can stir
-// forever"), settles with them, and stays bitwise identical on one and two threads.
+// crumple of CollisionScenesTest settles at a tight solver tolerance, a napkin folded by its pins
+// stays untangled whatever the solve's form, and the pile is bitwise identical on one and two
+// threads.
 #include "ContactTestSupport.h"
-#include "KnownEngineFailure.h"
 
 #include <weft/collision/Plane.h>
 #include <weft/engine/FabricPresets.h>
@@ -30,21 +29,11 @@ constexpr Real kFrame = 1.0 / 60.0;
 // The corner crumple of CollisionScenesTest at cgTolerance 1e-4 (relative residual), over eight
 // drop heights (27 to 31.7 cm; the pile is a chaotic outcome of the drop). Without self-contacts
 // in the solve such piles keep stirring (tests/README.md, "The crumpled piles"); with them
-// (stiffness 1) each draw must settle: kinetic energy below 1e-5 J after 400 frames. Every draw
-// also asserts no intersecting pair and no vertex in the floor after every frame, that the cloth
-// lay on itself and came down, the strain condition (cotton: the limit + 0.01), and no
-// rollback or retry.
+// (stiffness 1, contact/SelfContactPenalty.h) each draw must settle: kinetic energy below 1e-5 J after 400
+// frames. Every draw also asserts no intersecting pair and no vertex in the floor after every
+// frame, that the cloth lay on itself and came down, the strain condition (cotton: the limit +
+// 0.01), and no rollback or retry.
 class SelfContactSolvePile : public ::testing::TestWithParam<Real> {};
-
-// Why a draw does not settle, with the figure; null: asserted. The pile is chaotic: the last bits
-// of the assembly decide which draw keeps a fold rocking.
-const char* pileKnownFailure(Real lift) {
-  if (lift == 0.302) {
-    return "this draw keeps a fold rocking: kinetic energy 3.8e-5 J after 400 frames; the seven "
-           "other heights settle";
-  }
-  return nullptr;
-}
 
 TEST_P(SelfContactSolvePile, ACrumpledPileSettlesAtATightSolverTolerance) {
   const Real lift = GetParam();
@@ -80,11 +69,7 @@ TEST_P(SelfContactSolvePile, ACrumpledPileSettlesAtATightSolverTolerance) {
   EXPECT_LT(test::meanVertexHeight(x), kSize / 4);
   EXPECT_LE(maxStrain, settings.material.strainLimit + 0.01);
   health.expectHealthy("pile");
-  if (const char* reason = pileKnownFailure(lift)) {
-    test::knownEngineFailure(energy < 1e-5, "kinetic energy below 1e-5 J after 400 frames", reason);
-  } else {
-    EXPECT_LT(energy, 1e-5) << "still stirring";
-  }
+  EXPECT_LT(energy, 1e-5) << "still stirring";
 }
 
 INSTANTIATE_TEST_SUITE_P(Heights, SelfContactSolvePile,

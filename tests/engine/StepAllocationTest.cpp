@@ -107,8 +107,8 @@ TEST(StepAllocation, SteadyStepsAllocateNothing) {
 }
 
 TEST(StepAllocation, ADensePadRestingOnASheetAllocatesNothing) {
-  // Two cloths in contact whose pass runs the strain limiter with the pairs held
-  // (ClothClothCollision): once the pad rests, the frames reuse the buffers of the first ones.
+  // Two cloths in contact, their pairs projected with the strain limits: once the pad rests,
+  // the frames reuse the buffers of the first ones.
   World world;
   auto square = [](Index vertices, Real size) {
     GridSettings grid;

@@ -88,5 +88,38 @@ TEST(StrainLimitStatus, AClothWithoutALimitHasNoneToExceed) {
   }
 }
 
+TEST(StrainLimitStatus, AFramePastTheLimitIsRedoneWithTwiceTheSubstepsUpToItsCap) {
+  // Pins 1.3 times the strip's length apart: no substep count can meet the limit, so each frame
+  // is redone with 2, 4 and 8 substeps (SolverSettings::strainRetrySubsteps, 8) and still flagged.
+  // With the retries off it keeps its one substep. (The frame of the pull itself takes three
+  // substeps for the pins' travel, SolverSettings::maxPinTravelPerSubstep.)
+  for (const Index cap : {Index(8), Index(0)}) {
+    World world;
+    ClothSettings settings = pinnedAtBothEnds(0.1);
+    settings.solver.strainRetrySubsteps = cap;
+    const ClothId cloth = world.createCloth(strip(), settings).value();
+    pullRightSide(world, cloth, settings, 0.3 * kWidth);
+    (void)world.step(kFrame);
+    for (int frame = 1; frame < 6; ++frame) {
+      const StepStatus status = world.step(kFrame);
+      EXPECT_TRUE(hasFlag(status, StepStatus::StrainLimitExceeded)) << "frame " << frame;
+      EXPECT_EQ(world.stats().strainRetries, cap == 8 ? 3u : 0u) << "frame " << frame;
+      EXPECT_EQ(world.stats().substeps, cap == 8 ? 8u : 1u) << "frame " << frame;
+    }
+  }
+}
+
+TEST(StrainLimitStatus, AFrameWithinTheLimitIsNotRedone) {
+  World world;
+  const ClothSettings settings = pinnedAtBothEnds(0.1);
+  const ClothId cloth = world.createCloth(strip(), settings).value();
+  pullRightSide(world, cloth, settings, 0.05 * kWidth);
+  for (int frame = 0; frame < 30; ++frame) {
+    (void)world.step(kFrame);
+    EXPECT_EQ(world.stats().strainRetries, 0u) << "frame " << frame;
+    EXPECT_EQ(world.stats().substeps, 1u) << "frame " << frame;
+  }
+}
+
 }  // namespace
 }  // namespace weft

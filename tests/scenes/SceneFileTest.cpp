@@ -43,24 +43,39 @@ TEST(SceneFile, EveryShippedSceneLoadsBuildsAndSteps) {
   }
 }
 
-TEST(SceneFile, FaceContactsAndTheJointProjectionCanBeTurnedOffPerCloth) {
-  for (const std::string key : {"faceContacts", "jointContactProjection"}) {
-    SCOPED_TRACE(key);
-    Result<SceneDescription> scene = loadSceneText(
-        R"({"version": 1, "cloths": [{"grid": {}, ")" + key + R"(": false}]})");
-    ASSERT_TRUE(scene.ok()) << scene.error().message;
-    const ClothSettings& settings = scene->cloths[0].settings;
-    EXPECT_FALSE(key == "faceContacts" ? settings.faceContacts : settings.jointContactProjection);
-    Result<SceneDescription> wrong = loadSceneText(
-        R"({"version": 1, "cloths": [{"grid": {}, ")" + key + R"(": "no"}]})");
-    ASSERT_FALSE(wrong.ok());
-    EXPECT_THAT(wrong.error().message, HasSubstr("/cloths/0/" + key));
-  }
-  // Both on unless a file says otherwise.
+TEST(SceneFile, FaceContactsCanBeTurnedOffPerCloth) {
+  Result<SceneDescription> scene =
+      loadSceneText(R"({"version": 1, "cloths": [{"grid": {}, "faceContacts": false}]})");
+  ASSERT_TRUE(scene.ok()) << scene.error().message;
+  EXPECT_FALSE(scene->cloths[0].settings.faceContacts);
+  Result<SceneDescription> wrong =
+      loadSceneText(R"({"version": 1, "cloths": [{"grid": {}, "faceContacts": "no"}]})");
+  ASSERT_FALSE(wrong.ok());
+  EXPECT_THAT(wrong.error().message, HasSubstr("/cloths/0/faceContacts"));
   Result<SceneDescription> plain = loadSceneText(R"({"version": 1, "cloths": [{"grid": {}}]})");
   ASSERT_TRUE(plain.ok());
   EXPECT_TRUE(plain->cloths[0].settings.faceContacts);
-  EXPECT_TRUE(plain->cloths[0].settings.jointContactProjection);
+}
+
+TEST(SceneFile, KeysOfRemovedSettingsSayWhatReplacedThem) {
+  // The rival contact pipeline's switch is gone: a file that still sets it is refused with a
+  // message that says why and what to do.
+  Result<SceneDescription> joint = loadSceneText(
+      R"({"version": 1, "cloths": [{"grid": {}, "jointContactProjection": true}]})");
+  ASSERT_FALSE(joint.ok());
+  EXPECT_THAT(joint.error().message, HasSubstr("/cloths/0/jointContactProjection"));
+  EXPECT_THAT(joint.error().message, HasSubstr("no longer exists"));
+}
+
+TEST(SceneFile, SelfContactsInTheSolveAreReadAndRangeChecked) {
+  Result<SceneDescription> on = loadSceneText(
+      R"({"version": 1, "cloths": [{"grid": {}, "solver": {"selfContactStiffness": 0.5}}]})");
+  ASSERT_TRUE(on.ok()) << on.error().message;
+  EXPECT_EQ(on->cloths[0].settings.solver.selfContactStiffness, 0.5);
+  Result<SceneDescription> negative = loadSceneText(
+      R"({"version": 1, "cloths": [{"grid": {}, "solver": {"selfContactStiffness": -1}}]})");
+  ASSERT_FALSE(negative.ok());
+  EXPECT_THAT(negative.error().message, HasSubstr("/cloths/0/solver/selfContactStiffness"));
 }
 
 TEST(SceneFile, DefaultsAreTheDocumentedOnes) {

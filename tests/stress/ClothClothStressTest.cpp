@@ -1,7 +1,7 @@
 // Stress scene 9 with the heavy objects as cloths of their own: two 0.5 kg pads dropped on a
 // 0.15 kg sheet pinned at its corners, three cloths of one World, so the pads load the sheet
-// through the contact between cloths (ClothClothCollision, run after every cloth has stepped)
-// instead of the self-collision. The same conditions as scene 9, and no intersecting pair
+// through the contacts between cloths (all cloths of a World share one contact space) instead of
+// the contacts of one cloth with itself. The same conditions as scene 9, and no intersecting pair
 // between the cloths either.
 #include "engine/ContactTestSupport.h"
 #include "stress/StressSupport.h"
@@ -61,9 +61,8 @@ TEST(StressClothCloth, HeavyClothsDroppedOnASheetPinnedAtItsCorners) {
   EXPECT_GT(secondPad, lowestSheet);
   EXPECT_EQ(worstBetween, 0u);
   EXPECT_GT(world.stats().clothContacts, 0u);
-  // StepStats::maxStrain is measured after the cloth–cloth pass. The pass holds its pairs inside
-  // one strain limiter over the cloths in contact (ClothClothCollision.h, "Strain limiting in
-  // contact"), so lifting the sheet lifts the pads with it.
+  // The projection holds the pairs between cloths and every cloth's strain limit together
+  // (ContactProjector.h), so lifting the sheet lifts the pads with it.
   monitor.expectPasses("heavy_cloths_on_sheet", kCottonStrainLimit);
 }
 

@@ -9,8 +9,8 @@
 //
 // The several sheets of scene 7, and the heavy objects and sheet of scene 9, are ONE ClothModel
 // made of disconnected layers (ClothModel::fromMesh), kept apart by the self-collision; they were
-// written before cloth–cloth collision between different cloths landed (World runs it after every
-// cloth has stepped, ClothClothCollision.h) and still test the self-collision path. The heavy
+// written before different cloths could touch (they now share one contact space) and still test
+// the contacts of one cloth with itself. The heavy
 // objects are small cloth pads (4 × 4 vertices, 12 cm) weighing 0.5 kg each, more than three
 // times the sheet (ClothSettings::vertexMasses): colliders are kinematic, so a weight the sheet
 // has to carry must be cloth.
@@ -204,9 +204,9 @@ TEST_P(StressRing, ThreeStackedSheetsPushedThroughARing) {
   // Faces are kept out of a capsule's core to its radius less the thickness.
   EXPECT_LE(outcome.deepestFaceInRing, cottonFabric().thickness + 1e-6)
       << "a face went deeper than the thickness into the ring (frame " << outcome.deepestFaceFrame << ")";
-  // The sheets jam between the pusher and the ring; the joint projection
-  // (ClothSettings::jointContactProjection) satisfies the edge limits, the self-contacts and the
-  // collider contacts together, so each draw stays within the limit (README, scene 7).
+  // The sheets jam between the pusher and the ring; the projection satisfies the edge limits, the
+  // self-contacts and the collider contacts together, and the frames it cannot bring within the
+  // limit are redone with more substeps, so each draw stays within the limit (README, scene 7).
   if (!draw.knownIntersections) {
     monitor->expectPasses(name, kCottonStrainLimit);
   } else {

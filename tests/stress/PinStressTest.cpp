@@ -6,7 +6,7 @@
 //   10  the pins of a hanging cloth teleported 10 m sideways in one frame: carried with them (a
 //       teleport, SolverSettings::pinTeleportDistance), the cloth passes every condition from
 //       the jump on; with the teleport rule off (dragged at 600 m/s) it must recover too, over
-//       six draws of the jump, of which three are known engine failures.
+//       six draws of the jump, of which one is a known engine failure.
 #include "stress/StressSupport.h"
 
 #include <Eigen/Geometry>
@@ -171,11 +171,11 @@ TEST(StressPins, PinsTeleportedTenMetresCarryTheClothThere) {
 // The dragged jump over draws: the jump changed by 0 … 3 mm (what bench/weft-teleport-perturb
 // --pin-teleport-distance 0 runs, there with pin removal on and off too). Every draw asserts the
 // stress conditions (strain from 2 s after the jump on) and that the energy is back within 1 %
-// of m·g·height for good within 2 s. In the draws of 0.1 mm and more the crash into the stopped
-// pins leaves a fold crushed in self-contact that the self-collision passes hold for the rest of
-// the run (400 to 900 proximity pairs and 200 to 400 swept impacts a frame): they stretch edges
-// after the strain limiter, which itself leaves no edge over. Those two conditions are known
-// engine failures there, with the figures measured (the other conditions still asserted).
+// of m·g·height for good within 2 s. In the draw of 0.1 mm the crash into the stopped
+// pins leaves a fold crushed in self-contact that a solve blind to the contacts keeps pushing
+// through the layer under it: the energy stays up. That condition is a known engine failure
+// there, with the figures measured (the stress conditions still asserted); with the contacts in
+// the solve (StressPins.PinsDraggedTenMetresRecoverWithSelfContactsInTheSolve) it holds.
 struct DraggedDraw {
   Real jumpOffset;        // m added to the 10 m jump
   const char* knownFailure;  // why its recovery fails, with the figures; null: asserted
@@ -199,13 +199,11 @@ TEST_P(StressPinsDragged, PinsDraggedTenMetresInOneFrameRecover) {
   EXPECT_LE(outcome.dragFrameStrain, kCottonStrainLimit + kStrainTolerance);
   const bool settled = outcome.settledAt >= 0 && outcome.settledAt <= 2.0;
   const std::string name = "dragged_pins_" + std::to_string(draw.jumpOffset);
+  monitor.expectPasses(name, kCottonStrainLimit);
   if (!draw.knownFailure) {
     EXPECT_TRUE(settled) << "the energy is not back within 1 % of m·g·height for good within 2 s";
-    monitor.expectPasses(name, kCottonStrainLimit);
     return;
   }
-  monitor.expectPasses(name, kCottonStrainLimit,
-                       {{StressMonitor::Condition::Strain, draw.knownFailure}});
   knownEngineFailure(settled, "energy back within 1 % of m·g·height within 2 s", draw.knownFailure);
 }
 
@@ -213,12 +211,10 @@ INSTANTIATE_TEST_SUITE_P(
     Jumps, StressPinsDragged,
     ::testing::Values(
         DraggedDraw{0, nullptr}, DraggedDraw{1e-6, nullptr}, DraggedDraw{1e-5, nullptr},
-        DraggedDraw{1e-4, "a fold crushed by the crash stays held in self-contact: strain 1.65 "
-                          "from 2 s on, energy 7 to 11 J above the settled 0.42 J for the 3 s"},
-        DraggedDraw{1e-3, "a fold crushed by the crash stays held in self-contact: strain 0.112 "
-                          "from 2 s on, energy not back within 1 % of m·g·height in 3 s"},
-        DraggedDraw{3e-3, "a fold crushed by the crash stays held in self-contact: strain 1.15 "
-                          "from 2 s on, energy not back within 1 % of m·g·height in 3 s"}),
+        DraggedDraw{1e-4, "a fold crushed by the crash keeps stirring: energy not back within 1 % "
+                          "of m·g·height in 3 s (peak strain 0.14 in the crash)"},
+        DraggedDraw{1e-3, nullptr},
+        DraggedDraw{3e-3, nullptr}),
     [](const ::testing::TestParamInfo<DraggedDraw>& info) {
       const Real offset = info.param.jumpOffset;
       return std::string("plus_") + (offset == 0      ? "0"
@@ -232,12 +228,8 @@ INSTANTIATE_TEST_SUITE_P(
 TEST(StressPins, PinsDraggedTenMetresRecoverWithSelfContactsInTheSolve) {
   // The same drag with the self-contacts inside the implicit solve
   // (SolverSettings::selfContactStiffness, off by default for its cost on the curtain) and every
-  // solve at the relative residual 1e-3 (the default's hard substeps): the crushed folds are no
-  // longer held by a solve that pulls layers through each other, and every one of the 24
-  // perturbed runs recovers (weft-teleport-perturb --pin-teleport-distance 0
-  // --self-contact-stiffness 1 --former-default-solve: 0 of 24 fail; 6 of 24 without the
-  // contacts; 4 of 24 with them at the default's loose solves between hard substeps). So all
-  // conditions hold.
+  // solve at the relative residual 1e-3 (the default's hard substeps): the crushed folds are held
+  // by the solve as well as by the projection, and all conditions hold.
   World world;
   StressMonitor monitor(world);
   const TeleportOutcome outcome = teleportScene(/*pinTeleportDistance=*/0, world, monitor,

@@ -50,8 +50,8 @@ void Bdf2::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real 
 }
 
 void Bdf2::saveCarriedState(Vec3Array& out) const {
-  Vec3Array warm;
-  m_implicit.saveCarriedState(warm);
+  // Straight into `out`, whose capacity a frame-start save reuses: no allocation in a steady step.
+  const std::span<const Vec3> warm = m_implicit.warmStart();
   out.clear();
   if (warm.empty() && !m_hasHistory) return;
   out.reserve(kHeaderSize + warm.size() + 2 * m_previousPosition.size());
@@ -62,6 +62,10 @@ void Bdf2::saveCarriedState(Vec3Array& out) const {
     out.insert(out.end(), m_previousPosition.begin(), m_previousPosition.end());
     out.insert(out.end(), m_previousVelocity.begin(), m_previousVelocity.end());
   }
+}
+
+std::size_t Bdf2::carriedStateCapacity(std::size_t vertexCount) const {
+  return kHeaderSize + 3 * vertexCount;  // the warm start, x_{n−1} and v_{n−1}
 }
 
 void Bdf2::restoreCarriedState(const Vec3Array& in) {

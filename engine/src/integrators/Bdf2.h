@@ -45,6 +45,7 @@ class Bdf2 final : public Integrator {
   void reset() override;
   /// The warm start and the history, so a restored world continues bit for bit.
   void saveCarriedState(Vec3Array& out) const override;
+  std::size_t carriedStateCapacity(std::size_t vertexCount) const override;
   void restoreCarriedState(const Vec3Array& in) override;
   /// Turns the warm start; forgets the history, whose positions would need the motion's
   /// translation too (a teleport's next step is a backward-Euler step).

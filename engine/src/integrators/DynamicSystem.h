@@ -76,7 +76,7 @@ class DynamicSystem {
   /// constraint applied along its constrained direction in the solve, (A Δv − b)·p (Baraff &
   /// Witkin's constraint force times h; positive pushes along p), zero for a row without one.
   /// The step's velocity change hides it (the constraint cancels the forces it resists), and
-  /// Coulomb friction needs it (ColliderResponse). Default: ignored.
+  /// Coulomb friction needs it (the contact projection's budget). Default: ignored.
   virtual void receiveContactImpulses(std::span<const Real> byRow) { (void)byRow; }
 
   /// Rank-one couplings of the system matrix outside its block pattern, from the last

@@ -16,9 +16,9 @@ namespace {
 constexpr int kContactReleasePasses = 2;
 // Re-solves of a step after contact constraints that pulled were released (BW98 §5.3): a
 // constraint whose impulse (A Δv − b)·n is negative holds a vertex on a collider that the
-// cloth's forces would take off it. A released vertex is free in the re-solve; the collider
-// response still keeps it out. Without the release the pressed shell of
-// ColliderResponse::constrain glues cloth to the floor (a sheet pulled 1.5 m up stays down).
+// cloth's forces would take off it. A released vertex is free in the re-solve; the contact
+// projection still keeps it out. Without the release the constraints of the predicted motion
+// glue cloth to the floor (a sheet pulled 1.5 m up stays down).
 constexpr int kConstraintReleasePasses = 2;
 
 }  // namespace

@@ -35,6 +35,7 @@
 #include "solver/FilteredPcg.h"
 #include "solver/VertexFilter.h"
 
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -69,6 +70,12 @@ class ImplicitEuler final : public Integrator {
     m_settings.cgStopping = stopping;
   }
   void saveCarriedState(Vec3Array& out) const override;
+  std::size_t carriedStateCapacity(std::size_t vertexCount) const override { return vertexCount; }
+  /// The warm start the next step takes (m/s per vertex; empty: none), what saveCarriedState()
+  /// writes, without a copy.
+  std::span<const Vec3> warmStart() const {
+    return m_hasWarmStart ? std::span<const Vec3>(m_deltaV) : std::span<const Vec3>();
+  }
   void restoreCarriedState(const Vec3Array& in) override;
   void rotateCarriedState(const Mat3& rotation) override;
 

@@ -54,6 +54,12 @@ class Integrator {
   /// warm start): saved and restored with the world so a restored world continues bit for bit.
   /// Empty when the method carries none.
   virtual void saveCarriedState(Vec3Array& out) const { out.clear(); }
+  /// The most entries saveCarriedState() writes for `vertexCount` vertices, so that a caller
+  /// saving it every frame sizes its buffer once.
+  virtual std::size_t carriedStateCapacity(std::size_t vertexCount) const {
+    (void)vertexCount;
+    return 0;
+  }
   /// Restores what saveCarriedState() wrote (an empty array = no carried state).
   virtual void restoreCarriedState(const Vec3Array& in) { (void)in; reset(); }
   /// Turns the carried state with a rigid motion of the whole system (a pin teleport that turns

@@ -19,7 +19,7 @@
 // symmetric and stable under tiny rotations instead of jumping between the two ends. Zero-length
 // segments are points.
 //
-// Segment–triangle (a capsule's core against a cloth triangle, ColliderFaceContacts): a segment
+// Segment–triangle (a capsule's core against a cloth triangle, the face contacts): a segment
 // that crosses the closed triangle is at distance 0 there; otherwise the closest pair has a
 // point on the boundary of one of the two, so it is the nearest of the segment's two ends
 // against the triangle and the segment against the triangle's three edges (five queries of the

@@ -36,6 +36,7 @@
 #include <weft/collision/RigidMotion.h>
 #include <weft/collision/ShapeContact.h>
 
+#include <memory>
 #include <optional>
 #include <span>
 #include <vector>
@@ -54,13 +55,13 @@ class TriangleMeshShape {
                                           const RigidMotion& motion = {});
 
   /// m, vertices in the body frame.
-  const std::vector<Vec3>& localVertices() const { return m_localVertices; }
+  const std::vector<Vec3>& localVertices() const { return m_geometry->vertices; }
   /// Three vertex indices per triangle.
-  const std::vector<Index>& indices() const { return m_indices; }
+  const std::vector<Index>& indices() const { return m_geometry->indices; }
   /// Number of triangles.
-  Index triangleCount() const { return static_cast<Index>(m_indices.size() / 3); }
+  Index triangleCount() const { return static_cast<Index>(m_geometry->indices.size() / 3); }
   /// The tree over the body-frame triangles (zero thickness).
-  const Bvh& localBvh() const { return m_localBvh; }
+  const Bvh& localBvh() const { return m_geometry->bvh; }
   /// Writes the vertices at the current pose into `vertices` (size localVertices().size()).
   void worldVertices(std::span<Vec3> vertices) const;
 
@@ -71,7 +72,7 @@ class TriangleMeshShape {
   /// True when every edge belongs to exactly two triangles (decided at create()): the mesh
   /// bounds a volume and queryPoint() signs its distance. False: an open, two-sided shell whose
   /// distance is unsigned (see the design note).
-  bool isClosed() const { return m_closed; }
+  bool isClosed() const { return m_geometry->closed; }
   /// Distance, closest point, normal and surface velocity for a world point. Closed mesh: signed
   /// distance (pseudo-normal sign, negative inside) and outward normal. Open mesh: unsigned
   /// distance and the normal from the closest point towards `point` (the face normal for a point
@@ -89,15 +90,21 @@ class TriangleMeshShape {
   Aabb bounds() const;
 
  private:
-  std::vector<Vec3> m_localVertices;
-  std::vector<Index> m_indices;
-  Bvh m_localBvh;
-  std::vector<Vec3> m_faceNormals;    // per triangle, unit
-  std::vector<Vec3> m_edgeNormals;    // per triangle corner k: edge (k, k+1), unit
-  std::vector<Vec3> m_vertexNormals;  // per vertex, angle-weighted, unit
+  TriangleMeshShape() = default;  // create() builds every shape: none exists without geometry
+  // The body-frame geometry, immutable once built and shared by every copy of the shape: a copy
+  // (a collider posed for one substep, a saved world) costs a reference count, not the mesh.
+  struct Geometry {
+    std::vector<Vec3> vertices;
+    std::vector<Index> indices;
+    Bvh bvh;
+    std::vector<Vec3> faceNormals;    // per triangle, unit
+    std::vector<Vec3> edgeNormals;    // per triangle corner k: edge (k, k+1), unit
+    std::vector<Vec3> vertexNormals;  // per vertex, angle-weighted, unit
+    std::vector<Vec3> corners;        // per triangle, its three vertices
+    bool closed = false;              // every edge has exactly two triangles
+  };
+  std::shared_ptr<const Geometry> m_geometry;
   RigidMotion m_motion;
-  std::vector<Vec3> m_corners;        // per triangle, its three vertices (body frame)
-  bool m_closed = false;              // every edge has exactly two triangles
 
   // The triangle closest to a body-frame point (the first found among equally close ones), or
   // kInvalidIndex when none is nearer than sqrt(maxSquared).

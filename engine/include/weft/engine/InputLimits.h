@@ -13,6 +13,11 @@ namespace weft {
 /// than this move their origin with the player.
 inline constexpr Real kMaxCoordinate = 1e6;
 
+/// m, the farthest from the origin a simulated vertex may go: a vertex beyond it is a failed
+/// substep (HealthFailure::OutOfRange), not a state to collide, since doubles there no longer
+/// resolve a cloth's thickness against its neighbours' (1.2e-7 m spacing). 10³ × kMaxCoordinate.
+inline constexpr Real kMaxSimulatedCoordinate = 1e9;
+
 /// m/s, the fastest a cloth vertex, the wind or a collider may move: the health monitor treats a
 /// vertex faster than this as a diverged integration (HealthFailure::Speed) and rolls it back.
 inline constexpr Real kMaxSpeed = 1e4;

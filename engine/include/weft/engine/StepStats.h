@@ -58,8 +58,9 @@ enum class HealthFailure : std::uint8_t {
   Speed,       ///< a vertex moved faster than kMaxSpeed (10⁴ m/s, InputLimits.h)
   Strain,      ///< an edge grew to more than 100× its rest length, longer than at the frame start
   EnergyJump,  ///< kinetic energy rose 100× above what the frame's own sources could supply
+  OutOfRange,  ///< a vertex went beyond kMaxSimulatedCoordinate (1e9 m, InputLimits.h)
 };
-/// "none", "non-finite", "speed", "strain" or "energy-jump".
+/// "none", "non-finite", "speed", "strain", "energy-jump" or "out-of-range".
 const char* describe(HealthFailure failure);
 
 /// Statistics of the last frame, summed over cloths and substeps (Box2D b2Profile in spirit).
@@ -82,26 +83,29 @@ struct StepStats {
   Real potentialEnergy = 0;
   Real maxSpeed = 0;           ///< m/s, fastest vertex at the end
   Index contacts = 0;          ///< cloth vertices touching a collider at the end
-  /// Cloth faces a collider had passed into between their vertices, pushed back out
-  /// (ColliderFaceContacts; first collision pass of every substep, summed)
+  /// Contacts of a cloth face with a collider that had passed between its vertices (detected
+  /// in every substep, summed)
   Index faceContacts = 0;
-  Index selfContacts = 0;      ///< self-proximity pairs repelled (all substeps)
-  Index selfImpacts = 0;       ///< swept self-collisions resolved by impulses (all substeps)
+  Index selfContacts = 0;      ///< contact pairs within one cloth (all substeps)
+  Index selfImpacts = 0;       ///< swept cloth collisions resolved by impulses (all substeps)
   Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
-  /// Vertices the self-collision last resort held at their step start because impulses and
+  /// Vertices the impact pass's last resort held at their step start because impulses and
   /// impact zones did not clear their contacts (all substeps): the contacts the engine did not
   /// resolve physically. They never cross; they stop instead.
   Index frozenVertices = 0;
-  /// Strain-limiter iterations (ClothMaterial::strainLimit), summed over cloths and substeps;
-  /// 0 when no edge went over its cloth's limit (or every limit is off).
+  /// Sweeps of the contact projection (strain limits and contacts together), summed over
+  /// substeps; 0 when no edge went over its limit and no contact was violated.
   int strainLimitIterations = 0;
-  /// Edges the strain limiter left over limit + 0.001 at its iteration cap, summed over cloths
-  /// and substeps (edges with both ends pinned not counted). The collision passes after it may
-  /// stretch edges a little more: maxStrain is what the frame ended with.
+  /// Edges the projection left over their limit at its sweep cap, summed over substeps (edges
+  /// with both ends pinned not counted). The impact pass after it may stretch edges a little
+  /// more: maxStrain is what the frame ended with.
   Index strainLimitEdgesOver = 0;
   /// Cloths that ended the frame past their strain limit + kStrainLimitSlack
   /// (StepStatus::StrainLimitExceeded).
   Index clothsOverStrainLimit = 0;
+  /// Times the frame was redone with twice the substeps because a cloth ended it past its strain
+  /// limit (SolverSettings::strainRetrySubsteps); `substeps` is what the kept attempt took.
+  Index strainRetries = 0;
 
   // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
   Real budgetMs = 0;           ///< ms, the budget this frame was given (0 = none)
@@ -113,8 +117,8 @@ struct StepStats {
   // substeps. Each pair counts the times the stage ran and the times it was skipped.
   Index colliderNarrowPhases = 0;  ///< cloth–collider pairs tested (constraint and response passes)
   Index colliderNarrowPhasesSkipped = 0;  ///< pairs skipped: the collider's box is not near the cloth's
-  Index selfCollisionPasses = 0;   ///< self-collision passes run (BVH refit, queries, response)
-  /// Passes skipped because the cloth provably cannot touch itself in that substep (FoldCulling:
+  Index selfCollisionPasses = 0;   ///< cloth-pair detections run (BVH refit, queries, response)
+  /// Passes skipped because the cloth provably cannot touch itself in that substep (fold culling:
   /// no fold, and features farther apart than the thickness plus twice the step's motion). A
   /// cloth with ClothSettings::selfCollision off counts neither run nor skipped passes.
   Index selfCollisionSkipped = 0;
@@ -125,9 +129,7 @@ struct StepStats {
   /// Cloths carried with their pins' jump this frame (SolverSettings::pinTeleportDistance).
   Index teleportedCloths = 0;
   StepStatus status = StepStatus::Ok;  ///< the flags step() returned
-  Index clothContacts = 0;     ///< proximity pairs between different cloths repelled
-  Index clothImpacts = 0;      ///< swept collisions resolved at the frame's cloth–cloth pass
-  Index clothImpactZones = 0;  ///< impact-zone passes of the cloth–cloth pass (fail-safe)
+  Index clothContacts = 0;     ///< contact pairs between different cloths (all substeps)
   /// The check the last failed attempt at this frame tripped (None when no attempt failed): why
   /// the frame was retried or rolled back. With several cloths, the first cloth that failed.
   HealthFailure healthFailure = HealthFailure::None;

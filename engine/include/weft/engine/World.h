@@ -28,9 +28,10 @@
 
 namespace weft {
 
-struct ColliderFrame;  // internal: a collider as one step sees it
+struct ColliderSource;  // internal: a collider as a frame sees it
+class Cloth;           // internal: one cloth's state, forces and integrator
 class FrameCostModel;  // internal: the budget planner
-class ClothClothCollision;  // internal: contact between cloths
+class SubstepPipeline;  // internal: the frame's substeps
 
 /// Handle to a cloth in a World. Zero-initialised = null.
 struct ClothId {
@@ -94,14 +95,10 @@ struct ClothSettings {
   /// or plank thinner than the triangles cannot pass between the vertices. Costs a box test per
   /// triangle per nearby collider and pass; turn off only for meshes much finer than every collider.
   bool faceContacts = true;
-  /// With the strain limiter on, in substeps where the cloth touches a collider and itself: the
-  /// edge limits, self-contacts and collider contacts are satisfied together, which keeps cloth
-  /// squeezed between bodies within its limit (up to 4× the limiter's work there). Off: in turn.
-  bool jointContactProjection = true;
   SleepSettings sleep;  ///< when the cloth at rest stops being simulated
   /// Keeps the cloth from passing through other cloths of the world that have this switch on
-  /// too (contact resolved once per frame, after every cloth has stepped). Costs a bounds test
-  /// per frame while the cloths are apart.
+  /// too (resolved in every substep with the cloth's own contacts). Costs a bounds test per
+  /// substep while the cloths are apart.
   bool collideWithOtherCloths = true;
 };
 
@@ -285,18 +282,15 @@ class World {
   const ColliderSlot* find(ColliderId collider) const;
   ColliderSlot* find(ColliderId collider);
   void updateAttachedPins(Real frameDt);
-  // Fills m_colliderFrames from m_colliderStartMotions: each collider from its frame-start
-  // motion to the same (a cloth poses them per substep itself) or, untilNow, to where it is now.
-  void gatherColliderFrames(bool untilNow);
 
   WorldSettings m_settings;
   std::unique_ptr<TaskSystem> m_ownedTasks;  // when the caller gave none
   TaskSystem* m_tasks = nullptr;
   std::vector<std::unique_ptr<ClothSlot>> m_slots;
   std::vector<std::unique_ptr<ColliderSlot>> m_colliderSlots;
-  std::vector<ColliderFrame> m_colliderFrames;  // scratch for step()
-  std::vector<RigidMotion> m_colliderStartMotions;  // scratch for step()
-  std::vector<Vec3> m_attachedTargets;              // scratch for step()
+  std::vector<ColliderSource> m_colliderSources;  // scratch for step()
+  std::vector<Cloth*> m_steppedCloths;            // scratch for step()
+  std::vector<Vec3> m_attachedTargets;            // scratch for step()
   // Runs one frame with `plan`; budgetMs > 0 reports a miss; the cost model is refitted from the
   // frame's timings (weight costSmoothing) assuming `defaultTolerance` where the plan has none.
   StepStatus stepWithPlan(Real frameDt, const StepPlan& plan, Real budgetMs, Real costSmoothing,
@@ -305,9 +299,7 @@ class World {
   StepStats m_stats;
   Real m_time = 0;
 
-  // Contact between cloths, after every cloth has stepped the frame (ClothClothCollision.h).
-  void collideCloths(Real frameDt, StepStats& stats);
-  std::unique_ptr<ClothClothCollision> m_clothContact;
+  std::unique_ptr<SubstepPipeline> m_pipeline;  // every frame's substeps
   std::uint64_t m_identity = 0;  // unique per World, so a state saved elsewhere is refused
   std::string m_settingsError;   // why the settings are invalid (then createCloth refuses)
 };

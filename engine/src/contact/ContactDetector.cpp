@@ -1,0 +1,437 @@
+#include "contact/ContactDetector.h"
+
+#include <weft/collision/Aabb.h>
+#include <weft/collision/ContinuousCollision.h>
+#include <weft/collision/Proximity.h>
+#include <weft/threading/Profiler.h>
+
+#include <algorithm>
+#include <cmath>
+#include <initializer_list>
+#include <variant>
+
+namespace weft {
+namespace {
+
+// Whether the boxes around two features' start positions come within `reach` of each other: when
+// they do not, the features are farther apart than `reach`, and the closest points need not be
+// worked out.
+bool withinReach(std::initializer_list<Index> first, std::initializer_list<Index> second,
+                 const Vec3Array& x, Real reach) {
+  Aabb a = Aabb::empty(), b = Aabb::empty();
+  for (Index i : first) a.expand(x[i]);
+  for (Index i : second) b.expand(x[i]);
+  a.inflate(reach);
+  return a.overlaps(b);
+}
+
+// A vertex resting on a collider within this fraction of the thickness beyond it is constrained
+// in the solve: every vertex of a cloth lying on a body then takes its own weight from the solve.
+// Left to round-off, some were and their neighbours were not, and the constrained ones carried
+// their neighbours' weight into friction's bound. A constraint that pulls is released by the
+// solve (ImplicitEuler), so the shell never glues.
+constexpr Real kPressedShell = 0.01;
+// A face within this fraction of the thickness beyond its reach at the substep start rests on
+// the body: it takes friction on its whole displacement.
+constexpr Real kRestingFaceShell = 0.01;
+// A pair that passed through itself within the substep is put back on its side this share of its
+// thickness apart (the impact stage's separation).
+constexpr Real kImpactSeparation = 0.25;
+// Feature pairs per parallel block: a closest-point test costs ~50–100 ns, so 128 pairs are
+// 5–15 µs of work, above a fork/join.
+constexpr TaskSystem::Index kGrainFeaturePairs = 128;
+
+// Thickness of a vertex's cloth.
+Real thicknessOf(const ContactSpace& space, Index vertex) {
+  return space.owners[space.owner[vertex]].thickness;
+}
+
+}  // namespace
+
+void ContactDetector::build(const ContactSpace& space, TaskSystem* tasks) {
+  m_tasks = tasks;
+  m_features.build(space, tasks);
+  m_pairFilter.build(tasks);
+}
+
+void ContactDetector::selectNear(const ContactSpace& space,
+                                 std::span<const ColliderFrame> colliders, const Vec3Array& end,
+                                 Real margin, DetectionCounts& counts) {
+  m_near.clear();
+  if (colliders.empty()) return;
+  Real thickness = 0;
+  for (const ContactOwner& owner : space.owners) thickness = std::max(thickness, owner.thickness);
+  // The paths of the free vertices; for a moving body, their starts carried with it too.
+  Aabb path = Aabb::empty();
+  for (Index i = 0; i < space.vertexCount(); ++i) {
+    if (space.inverseMass[i] == 0) continue;
+    path.expand(space.startX[i]);
+    path.expand(end[i]);
+  }
+  const Real reach = thickness * (1 + 1e-6) + margin + 1e-9;
+  for (Index k = 0; k < Index(colliders.size()); ++k) {
+    const ColliderFrame& collider = colliders[k];
+    Aabb box = path;
+    if (!collider.still()) {
+      // A turning body: the paths relative to it are arcs, which stray from their chords.
+      Real bulge = 0;
+      for (Index i = 0; i < space.vertexCount(); ++i) {
+        if (space.inverseMass[i] == 0) continue;
+        box.expand(collider.carry(space.startX[i]));
+        bulge = std::max(bulge, pathBulge(collider, space.startX[i], end[i]));
+      }
+      box.inflate(bulge);
+    }
+    if (!m_skip || mayTouch(collider.shape, box, reach)) {
+      m_near.push_back(k);
+      ++counts.colliderPairsTested;
+    } else {
+      ++counts.colliderPairsSkipped;
+    }
+  }
+}
+
+void ContactDetector::constrain(const ContactSpace& space,
+                                std::span<const ColliderFrame> colliders, Real h,
+                                std::span<const FaceSupport> supports,
+                                std::vector<SolveConstraint>& out, DetectionCounts& counts) {
+  out.clear();
+  WEFT_PROFILE_ZONE("constrain");
+  const Index n = space.vertexCount();
+  // The predicted ends, for the box test (kept in the space's velocity-sized scratch below).
+  m_predicted.resize(n);
+  for (Index i = 0; i < n; ++i) m_predicted[i] = space.startX[i] + h * space.startV[i];
+  selectNear(space, colliders, m_predicted, 0, counts);
+  m_constrained.assign(n, 0);
+  if (!m_near.empty()) {
+    for (Index i = 0; i < n; ++i) {
+      if (space.inverseMass[i] == 0) continue;
+      const Real thickness = thicknessOf(space, i);
+      const Vec3& predicted = m_predicted[i];
+      // The deepest contact wins when a vertex touches several colliders: one direction per
+      // vertex in the solve; the projector then keeps it off the others.
+      Real deepest = (1 + kPressedShell) * thickness;
+      Vec3 normal = Vec3::Zero();
+      Index touched = kInvalidIndex;
+      for (Index k : m_near) {
+        const ColliderFrame& collider = colliders[k];
+        const ShapeContact contact = queryPoint(collider.shape, predicted);
+        Vec3 direction = contact.normal;
+        Real depth = contact.distance;
+        // Where the predicted motion relative to the body first meets it gives the face to stop
+        // on: the end pose alone would push a vertex a fast body overran out through its far side.
+        if (const std::optional<PathContact> hit =
+                firstContactAlong(collider, space.startX[i], predicted, thickness)) {
+          // A path that stays outside after it comes near is a graze: the end's own distance
+          // holds. Extrapolating the hit's tangent plane would overshoot on a curved body. A
+          // two-sided shell (an open mesh) has no inside to show the middle in: there the path
+          // from the hit on is tested for a crossing instead.
+          const bool graze =
+              contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
+              queryPoint(collider.shape, 0.5 * (hit->point + predicted)).distance > 0 &&
+              !shellCrossing(collider.shape, hit->point, predicted);
+          if (!graze) {
+            direction = hit->impactNormal;
+            depth = hit->distance + hit->normal.dot(predicted - hit->point);
+          }
+        }
+        if (depth < deepest) {
+          deepest = depth;
+          normal = direction;
+          touched = k;
+        }
+      }
+      if (touched == kInvalidIndex) continue;
+      // n·Δv that ends the step at the thickness: d(x + h(v + Δv)) ≈ d(x + h v) + h n·Δv.
+      out.push_back({i, normal, (thickness - deepest) / h, touched});
+      m_constrained[i] = 1;
+    }
+  }
+  // Faces resting on a body by their interior: their corners are clear of it, so the vertex
+  // constraints do not hold them, and the solve would sink the face h² g a step into the body.
+  // Each corner is constrained along the support's normal so that the face point ends the step
+  // at its level; one that rests a little clear comes down onto it, as a pressed vertex does.
+  for (const FaceSupport& support : supports) {
+    Vec3 point = Vec3::Zero(), velocity = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+      point += support.barycentric[k] * space.startX[support.corners[k]];
+      velocity += support.barycentric[k] * space.startV[support.corners[k]];
+    }
+    const Real thickness = thicknessOf(space, support.corners[0]);
+    const Real gap = support.normal.dot(point) - support.level;
+    if (gap > kPressedShell * thickness && gap + h * support.normal.dot(velocity) > 0) continue;
+    const Real speed = -gap / h;
+    for (int k = 0; k < 3; ++k) {
+      const Index corner = support.corners[k];
+      if (!(support.barycentric[k] > 0) || space.inverseMass[corner] == 0 || m_constrained[corner]) {
+        continue;
+      }
+      out.push_back({corner, support.normal, speed - support.normal.dot(space.startV[corner]),
+                     kFaceCornerConstraint});
+      m_constrained[corner] = 1;
+    }
+  }
+  // By vertex: the filter is written in this order.
+  std::sort(out.begin(), out.end(),
+            [](const SolveConstraint& a, const SolveConstraint& b) { return a.vertex < b.vertex; });
+}
+
+void ContactDetector::detect(const ContactSpace& space, std::span<const ColliderFrame> colliders,
+                             std::span<const Real> solveImpulses,
+                             std::span<const Index> constrainedCollider, bool pairs, Real margin,
+                             ContactSet& set, DetectionCounts& counts) {
+  WEFT_PROFILE_ZONE("detect");
+  set.clear();
+  selectNear(space, colliders, space.x, margin, counts);
+  if (!m_near.empty()) {
+    detectColliderVertices(space, colliders, solveImpulses, constrainedCollider, margin, set);
+    detectColliderFaces(space, colliders, solveImpulses, constrainedCollider, margin, set);
+  }
+  set.firstPair = set.contacts.size();
+  if (pairs) detectPairs(space, set);
+}
+
+void ContactDetector::detectColliderVertices(const ContactSpace& space,
+                                             std::span<const ColliderFrame> colliders,
+                                             std::span<const Real> solveImpulses,
+                                             std::span<const Index> constrainedCollider,
+                                             Real margin, ContactSet& set) {
+  for (Index i = 0; i < space.vertexCount(); ++i) {
+    if (space.inverseMass[i] == 0) continue;
+    const Real thickness = thicknessOf(space, i);
+    const Real friction = space.owners[space.owner[i]].friction;
+    for (Index k : m_near) {
+      const ColliderFrame& collider = colliders[k];
+      const Vec3 start = collider.carry(space.startX[i]);
+      const ShapeContact end = queryPoint(collider.shape, space.x[i]);
+      const std::optional<PathContact> hit =
+          end.distance < thickness + margin
+              ? std::nullopt
+              : firstContactAlong(collider, space.startX[i], space.x[i], thickness);
+      if (!(end.distance < thickness + margin) && !hit) continue;
+      Contact contact;
+      contact.kind = ContactKind::VertexCollider;
+      contact.vertices[0] = i;
+      contact.normal = hit ? hit->normal : end.normal;
+      contact.separation = thickness;
+      contact.gap = end.distance;
+      contact.friction = std::sqrt(std::max<Real>(0, collider.friction) * friction);
+      contact.collider = k;
+      contact.resting =
+          queryPoint(collider.shape, start).distance < (1 + kPressedShell) * thickness;
+      if (!solveImpulses.empty() && constrainedCollider[i] == k) {
+        contact.solveImpulse = std::max<Real>(0, solveImpulses[i]);
+      }
+      set.contacts.push_back(contact);
+    }
+  }
+}
+
+void ContactDetector::detectColliderFaces(const ContactSpace& space,
+                                          std::span<const ColliderFrame> colliders,
+                                          std::span<const Real> solveImpulses,
+                                          std::span<const Index> constrainedCollider,
+                                          Real margin, ContactSet& set) {
+  WEFT_PROFILE_ZONE("face contacts");
+  for (Index k : m_near) {
+    const ColliderFrame& collider = colliders[k];
+    const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&collider.shape);
+    const Aabb body = bounds(collider.shape);
+    const Pose& endPose = collider.end.pose;
+    const Pose& startPose = collider.start.pose;
+    for (Index t = 0; t < Index(space.triangles.size()); ++t) {
+      const std::array<Index, 3>& corner = space.triangles[t];
+      if (!space.faceContacts(corner[0])) continue;
+      if (space.inverseMass[corner[0]] == 0 && space.inverseMass[corner[1]] == 0 &&
+          space.inverseMass[corner[2]] == 0) {
+        continue;
+      }
+      // Start and end: a face may cross a thin body within one substep. With the margin: the
+      // projection may move a face that far towards the body.
+      Aabb box = Aabb::empty();
+      for (Index i : corner) {
+        box.expand(space.x[i]);
+        box.expand(space.startX[i]);
+      }
+      box.inflate(margin);
+      if (!box.overlaps(body)) continue;
+      const Real allowance = thicknessOf(space, corner[0]);
+      m_bodyCores.clear();
+      appendCores(collider.shape, allowance, m_bodyCores);
+      if (m_bodyCores.empty() && !mesh) continue;  // a plane: vertices only
+      // The face's path in the body's frame (start and end), against each core's box.
+      Aabb path = Aabb::empty();
+      std::array<Vec3, 3> startLocal;
+      for (int j = 0; j < 3; ++j) {
+        startLocal[j] = startPose.toLocal(space.startX[corner[j]]);
+        path.expand(startLocal[j]);
+        path.expand(endPose.toLocal(space.x[corner[j]]));
+      }
+      path.inflate(margin);
+      if (mesh) {
+        Aabb near = path;
+        near.inflate(0.5 * allowance);
+        appendMeshCores(*mesh, near, allowance, m_bodyCores, m_meshTriangles, m_meshEdges);
+      }
+      for (const FaceCore& core : m_bodyCores) {
+        if (!core.box.overlaps(path)) continue;
+        // Which side of the core the face started on (zero: it started on the core).
+        const SegmentTriangleClosestPoints before = closestPointsOnSegmentAndTriangle(
+            core.start, core.end, startLocal[0], startLocal[1], startLocal[2]);
+        Contact contact;
+        contact.kind = ContactKind::FaceCollider;
+        contact.vertices = {corner[0], corner[1], corner[2], kInvalidIndex};
+        contact.weights = {0, 0, 0, 0};
+        if (before.distance > 0) {
+          contact.normal = (before.pointOnTriangle - before.pointOnSegment) / before.distance;
+        }
+        contact.separation = core.reach;
+        contact.gap = before.distance - core.reach;
+        contact.friction = std::sqrt(std::max<Real>(0, collider.friction) *
+                                     space.owners[space.owner[corner[0]]].friction);
+        contact.collider = k;
+        contact.core = Index(set.cores.size());
+        contact.resting = before.distance <= core.reach + kRestingFaceShell * allowance;
+        // The solve's support of a face resting on the body: its corners' constraints, averaged
+        // as the centroid where friction acts takes them.
+        if (!solveImpulses.empty()) {
+          for (Index i : corner) {
+            if (constrainedCollider[i] == kFaceCornerConstraint) {
+              contact.solveImpulse += std::max<Real>(0, solveImpulses[i]) / 3;
+            }
+          }
+        }
+        set.cores.push_back(core);
+        set.contacts.push_back(contact);
+      }
+    }
+  }
+}
+
+void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
+  Real maxThickness = 0;
+  for (const ContactOwner& owner : space.owners) maxThickness = std::max(maxThickness, owner.thickness);
+  m_pairMargin = kPairReach * maxThickness;
+  m_features.find(space, space.startX, space.x, m_pairMargin);
+  const auto& vertexTriangle = m_features.vertexTriangle();
+  const auto& edgeEdgePairs = m_features.edgeEdge();
+  const Index vertexTriangleCount = Index(vertexTriangle.size());
+  const Index total = vertexTriangleCount + Index(edgeEdgePairs.size());
+  const Vec3Array& x0 = space.startX;
+  const Vec3Array& x1 = space.x;
+  // The contact of a pair (see the file comment): closer than its thickness at the start, with
+  // the start's closest points, whose side x₀ (free of crossings) gives (Bridson, Fedkiw &
+  // Anderson 2002's proximity); or passed through itself within the motion (a change of side of
+  // the vertex against the face's plane, or of the edges against each other, is the cheap sign,
+  // the swept test decides), with the point of the hit and the side it came from. A pair that
+  // only ends close is left to the next substep's start, where its side is known.
+  auto vertexFace = [&](Index vertex, Index triangle, Contact& contact) -> bool {
+    const std::array<Index, 3>& c = space.triangles[triangle];
+    const Real thickness = space.pairThickness(vertex, c[0]);
+    const Vec3 n0 = (x0[c[1]] - x0[c[0]]).cross(x0[c[2]] - x0[c[0]]);
+    const Vec3 n1 = (x1[c[1]] - x1[c[0]]).cross(x1[c[2]] - x1[c[0]]);
+    const bool sideChanged = n0.dot(x0[vertex] - x0[c[0]]) * n1.dot(x1[vertex] - x1[c[0]]) <= 0;
+    if (!sideChanged && !withinReach({vertex}, {c[0], c[1], c[2]}, x0, kPairReach * thickness)) {
+      return false;
+    }
+    const TriangleClosestPoint start = closestPointOnTriangle(x0[vertex], x0[c[0]], x0[c[1]], x0[c[2]]);
+    if (!(start.distance < kPairReach * thickness) && !sideChanged) return false;
+    // Neighbours in the material (within the pairs' reach at rest): the elastic forces keep
+    // them apart.
+    if (space.owner[vertex] == space.owner[c[0]] &&
+        closestPointOnTriangle(space.rest[vertex], space.rest[c[0]], space.rest[c[1]],
+                               space.rest[c[2]]).distance < kPairReach * thickness) {
+      return false;
+    }
+    contact.kind = ContactKind::VertexFace;
+    contact.vertices = {vertex, c[0], c[1], c[2]};
+    contact.separation = thickness;
+    contact.friction = space.pairFriction(vertex, c[0]);
+    contact.resting = start.distance < thickness;
+    contact.gap = start.distance;
+    if (!(start.distance < kPairReach * thickness)) {
+      const std::optional<VertexTriangleImpact> hit = sweptVertexTriangle(
+          x0[vertex], x1[vertex], {x0[c[0]], x0[c[1]], x0[c[2]]}, {x1[c[0]], x1[c[1]], x1[c[2]]});
+      if (!hit) return false;
+      contact.weights = {1, -hit->barycentric[0], -hit->barycentric[1], -hit->barycentric[2]};
+      contact.normal = hit->normal;
+      contact.gap = 0;
+      contact.separation = kImpactSeparation * thickness;
+      return true;
+    }
+    contact.weights = {1, -start.barycentric[0], -start.barycentric[1], -start.barycentric[2]};
+    Vec3 normal = x0[vertex] - start.point;
+    if (start.distance < 1e-9 * thickness) normal = n0;
+    if (normal.norm() == 0) return false;
+    contact.normal = normal.normalized();
+    return true;
+  };
+  auto edgeEdge = [&](Index firstEdge, Index secondEdge, Contact& contact) -> bool {
+    const std::array<Index, 2>& p = space.edges[firstEdge];
+    const std::array<Index, 2>& q = space.edges[secondEdge];
+    const Real thickness = space.pairThickness(p[0], q[0]);
+    const Vec3 n0 = (x0[p[1]] - x0[p[0]]).cross(x0[q[1]] - x0[q[0]]);
+    const Vec3 n1 = (x1[p[1]] - x1[p[0]]).cross(x1[q[1]] - x1[q[0]]);
+    const bool sideChanged = n0.dot(x0[p[0]] - x0[q[0]]) * n1.dot(x1[p[0]] - x1[q[0]]) <= 0;
+    if (!sideChanged && !withinReach({p[0], p[1]}, {q[0], q[1]}, x0, kPairReach * thickness)) {
+      return false;
+    }
+    const SegmentClosestPoints start = closestPointsOnSegments(x0[p[0]], x0[p[1]], x0[q[0]], x0[q[1]]);
+    if (!(start.distance < kPairReach * thickness) && !sideChanged) return false;
+    if (space.owner[p[0]] == space.owner[q[0]] &&
+        closestPointsOnSegments(space.rest[p[0]], space.rest[p[1]], space.rest[q[0]],
+                                space.rest[q[1]]).distance < kPairReach * thickness) {
+      return false;
+    }
+    contact.kind = ContactKind::EdgeEdge;
+    contact.vertices = {p[0], p[1], q[0], q[1]};
+    contact.separation = thickness;
+    contact.friction = space.pairFriction(p[0], q[0]);
+    contact.resting = start.distance < thickness;
+    contact.gap = start.distance;
+    if (!(start.distance < kPairReach * thickness)) {
+      const std::optional<EdgeEdgeImpact> hit =
+          sweptEdgeEdge({x0[p[0]], x0[p[1]]}, {x1[p[0]], x1[p[1]]}, {x0[q[0]], x0[q[1]]},
+                        {x1[q[0]], x1[q[1]]});
+      if (!hit) return false;
+      const Real s = hit->firstParameter, u = hit->secondParameter;
+      contact.weights = {1 - s, s, -(1 - u), -u};
+      contact.normal = hit->normal;
+      contact.gap = 0;
+      contact.separation = kImpactSeparation * thickness;
+      return true;
+    }
+    const Real s = start.firstParameter, u = start.secondParameter;
+    contact.weights = {1 - s, s, -(1 - u), -u};
+    Vec3 normal = ((1 - s) * x0[p[0]] + s * x0[p[1]]) - ((1 - u) * x0[q[0]] + u * x0[q[1]]);
+    if (start.distance < 1e-9 * thickness) normal = n0;
+    if (normal.norm() == 0) return false;
+    contact.normal = normal.normalized();
+    return true;
+  };
+  auto test = [&](Index pair, Contact& contact) -> bool {
+    const bool found =
+        pair < vertexTriangleCount
+            ? vertexFace(vertexTriangle[pair][0], vertexTriangle[pair][1], contact)
+            : edgeEdge(edgeEdgePairs[pair - vertexTriangleCount][0],
+                       edgeEdgePairs[pair - vertexTriangleCount][1], contact);
+    if (found && contact.resting) {
+      // A pair that starts the substep closer than its thickness need only part of the way back
+      // to it in one substep (Bridson, Fedkiw & Anderson 2002's repulsion rate), never closer
+      // than it started: folds pressed tighter than two thicknesses (a sandwiched layer) would
+      // otherwise ask for positions no projection can reach.
+      Real startGap = 0;
+      Vec3 start = Vec3::Zero();
+      for (int k = 0; k < 4; ++k) start += contact.weights[k] * x0[contact.vertices[k]];
+      startGap = std::max<Real>(0, contact.normal.dot(start));
+      if (startGap < contact.separation) {
+        contact.separation = startGap + kRepulsionRate * (contact.separation - startGap);
+      }
+    }
+    return found;
+  };
+  WEFT_PROFILE_ZONE("narrow phase");
+  m_pairFilter.run(total, kGrainFeaturePairs, test, set.contacts);
+}
+
+}  // namespace weft

@@ -1,0 +1,249 @@
+#include "contact/FeaturePairs.h"
+
+#include <weft/threading/GrainSizes.h>
+#include <weft/threading/Profiler.h>
+
+#include <algorithm>
+
+namespace weft {
+namespace {
+
+// Candidate triangle pairs per parallel block when collecting feature pairs: a few box tests
+// each, ~50–100 ns, so 256 pairs are ~15–25 µs of work.
+constexpr TaskSystem::Index kGrainTrianglePairs = 256;
+// Above one dirty triangle in this many, one self query (filtered) is cheaper than a box query
+// per dirty triangle: a box query visits a few dozen nodes, a self query every overlapping pair.
+constexpr Index kBoxQueriesPerSelfQuery = 8;
+
+}  // namespace
+
+void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
+  m_tasks = tasks;
+  if (m_tasks && !m_workerPairs) {
+    m_workerPairs = std::make_unique<PerWorker<std::vector<TrianglePair>>>(*m_tasks);
+  }
+  std::vector<Index> indices;
+  indices.reserve(3 * space.triangles.size());
+  for (const auto& triangle : space.triangles) indices.insert(indices.end(), triangle.begin(), triangle.end());
+  // The tree groups triangles by their rest shape, which keeps leaves coherent as the cloth
+  // deforms; each cloth's rest shape is laid beside the others' so that no leaf mixes cloths.
+  Vec3Array layout(space.rest.size());
+  Real shift = 0;
+  std::size_t begin = 0;
+  while (begin < space.rest.size()) {
+    std::size_t end = begin;
+    Aabb box = Aabb::empty();
+    while (end < space.rest.size() && space.owner[end] == space.owner[begin]) box.expand(space.rest[end++]);
+    for (std::size_t i = begin; i < end; ++i) layout[i] = space.rest[i] + Vec3(shift - box.min.x(), 0, 0);
+    shift += (box.max.x() - box.min.x()) + 1;
+    begin = end;
+  }
+  const Real margin = m_bvh.refitMargin();
+  m_bvh = Bvh::build(indices, layout).value();
+  m_bvh.setRefitMargin(margin);
+
+  const Index vertexCount = space.vertexCount();
+  m_vertexTriangleBegin.assign(vertexCount + 1, 0);
+  for (const auto& triangle : space.triangles) {
+    for (Index vertex : triangle) ++m_vertexTriangleBegin[vertex + 1];
+  }
+  for (Index i = 0; i < vertexCount; ++i) m_vertexTriangleBegin[i + 1] += m_vertexTriangleBegin[i];
+  m_vertexTriangles.resize(m_vertexTriangleBegin[vertexCount]);
+  std::vector<Index> fill(m_vertexTriangleBegin.begin(), m_vertexTriangleBegin.end() - 1);
+  for (Index t = 0; t < Index(space.triangles.size()); ++t) {
+    for (Index vertex : space.triangles[t]) m_vertexTriangles[fill[vertex]++] = t;
+  }
+  m_edgeTriangles.assign(space.edges.size(), {kInvalidIndex, kInvalidIndex});
+  for (Index t = 0; t < Index(space.triangleEdges.size()); ++t) {
+    for (Index edge : space.triangleEdges[t]) {
+      std::array<Index, 2>& slots = m_edgeTriangles[edge];
+      (slots[0] == kInvalidIndex ? slots[0] : slots[1]) = t;
+    }
+  }
+  m_vertexBoxes.resize(vertexCount);
+  m_triangleBoxes.resize(space.triangles.size());
+  m_edgeBoxes.resize(space.edges.size());
+}
+
+void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
+                                     const Vec3Array& to, Real inflate,
+                                     const std::vector<char>* dirty) {
+  WEFT_PROFILE_ZONE("broad phase");
+  m_bvh.refit(from, to, inflate, m_tasks);
+  m_refitCounts.refitNodes += m_bvh.lastRefitCounts().refitNodes;
+  m_refitCounts.skippedNodes += m_bvh.lastRefitCounts().skippedNodes;
+  Index dirtyTriangles = 0;
+  if (dirty) {
+    m_dirtyTriangle.resize(space.triangles.size());
+    for (std::size_t t = 0; t < space.triangles.size(); ++t) {
+      const auto& c = space.triangles[t];
+      m_dirtyTriangle[t] = (*dirty)[c[0]] | (*dirty)[c[1]] | (*dirty)[c[2]];
+      dirtyTriangles += m_dirtyTriangle[t] != 0;
+    }
+  }
+  if (dirty && dirtyTriangles * kBoxQueriesPerSelfQuery <= Index(space.triangles.size())) {
+    // Each dirty triangle's own box against the tree: the pairs the self query would report
+    // with it (the same leaf test), a pair of two dirty triangles taken from its lower one.
+    m_trianglePairs.clear();
+    const std::vector<Index>& order = m_bvh.triangleOrder();
+    for (Index slot = 0; slot < Index(order.size()); ++slot) {
+      const Index triangle = order[slot];
+      if (!m_dirtyTriangle[triangle]) continue;
+      m_bvh.queryBox(m_bvh.slotBounds(slot), m_boxHits);
+      for (Index other : m_boxHits) {
+        if (other == triangle || (m_dirtyTriangle[other] && other < triangle)) continue;
+        if (trianglesShareVertex(space.triangles[triangle], space.triangles[other])) continue;
+        m_trianglePairs.push_back({std::min(triangle, other), std::max(triangle, other)});
+      }
+    }
+    std::sort(m_trianglePairs.begin(), m_trianglePairs.end());
+  } else if (m_tasks && m_workerPairs) {
+    m_bvh.querySelf(m_trianglePairs, *m_tasks, *m_workerPairs);
+    // Which worker finds which pairs depends on scheduling: room for all in every worker's
+    // list, so allocation follows the number of pairs, never the timing of the threads.
+    const std::size_t total = m_trianglePairs.size();
+    m_workerPairs->forEach([total](std::vector<TrianglePair>& list) {
+      if (list.capacity() < total) list.reserve(total);
+    });
+  } else {
+    m_bvh.querySelf(m_trianglePairs);
+  }
+  std::erase_if(m_trianglePairs, [&](const TrianglePair& pair) {
+    if (dirty && !m_dirtyTriangle[pair.first] && !m_dirtyTriangle[pair.second]) return true;
+    return !space.pairsAllowed(space.triangles[pair.first][0], space.triangles[pair.second][0]);
+  });
+}
+
+void FeaturePairs::find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
+                        Real inflate, const std::vector<char>* dirty) {
+  findTrianglePairs(space, from, to, inflate, dirty);
+  collect(space, from, to, inflate, dirty);
+}
+
+void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
+                           Real margin, const std::vector<char>* dirty) {
+  WEFT_PROFILE_ZONE("feature pairs");
+  const auto& triangles = space.triangles;
+  const auto& edges = space.edges;
+  // Every vertex's, triangle's and edge's box over the step, once.
+  const Index vertexCount = space.vertexCount();
+  const Index triangleCount = Index(triangles.size()), edgeCount = Index(edges.size());
+  auto boxVertices = [&](Index begin, Index end, int) {
+    for (Index i = begin; i < end; ++i) m_vertexBoxes[i] = Aabb::fromCorners(from[i], to[i]);
+  };
+  auto boxFeatures = [&](Index begin, Index end, int) {
+    for (Index i = begin; i < end; ++i) {
+      if (i < triangleCount) {
+        const auto& c = triangles[i];
+        Aabb box = m_vertexBoxes[c[0]];
+        box.expand(m_vertexBoxes[c[1]]);
+        box.expand(m_vertexBoxes[c[2]]);
+        m_triangleBoxes[i] = box;
+      } else {
+        const auto& c = edges[i - triangleCount];
+        Aabb box = m_vertexBoxes[c[0]];
+        box.expand(m_vertexBoxes[c[1]]);
+        m_edgeBoxes[i - triangleCount] = box;
+      }
+    }
+  };
+  if (m_tasks) {
+    m_tasks->parallelFor(vertexCount, kGrainVertices, boxVertices);
+    m_tasks->parallelFor(triangleCount + edgeCount, kGrainVertices, boxFeatures);
+  } else {
+    boxVertices(0, vertexCount, 0);
+    boxFeatures(0, triangleCount + edgeCount, 0);
+  }
+  auto shares = [&](Index a, Index b) { return trianglesShareVertex(triangles[a], triangles[b]); };
+  // Canonical ownership (see the file comment), tested cheaply: stop at the first candidate
+  // that beats the pair at hand.
+  auto isVertexOwner = [&](Index vertex, Index owner, Index triangle) {
+    for (Index k = m_vertexTriangleBegin[vertex]; k < m_vertexTriangleBegin[vertex + 1]; ++k) {
+      const Index candidate = m_vertexTriangles[k];
+      if (candidate == owner) return true;
+      if (!shares(candidate, triangle)) return false;
+    }
+    return false;
+  };
+  auto isEdgeOwner = [&](Index a, Index b, const TrianglePair& pair) {
+    bool listed = false;
+    for (Index ta : m_edgeTriangles[a]) {
+      for (Index tb : m_edgeTriangles[b]) {
+        if (ta == kInvalidIndex || tb == kInvalidIndex) continue;
+        const TrianglePair candidate{std::min(ta, tb), std::max(ta, tb)};
+        if (candidate < pair && !shares(ta, tb)) return false;
+        listed = listed || candidate == pair;
+      }
+    }
+    return listed;
+  };
+  auto isDirty = [&](Index vertex) { return !dirty || (*dirty)[vertex]; };
+  auto collectRange = [&](Index begin, Index end, std::vector<std::array<Index, 2>>& vertexTriangle,
+                          std::vector<std::array<Index, 2>>& edgeEdge) {
+    for (Index k = begin; k < end; ++k) {
+      const TrianglePair& pair = m_trianglePairs[k];
+      const Aabb& firstBox = m_triangleBoxes[pair.first];
+      const Aabb& secondBox = m_triangleBoxes[pair.second];
+      // Every feature box of a triangle lies in its box: when the inflated triangle box misses
+      // the other triangle's, so does every test of that side.
+      Aabb firstReach = firstBox, secondReach = secondBox;
+      firstReach.inflate(margin);
+      secondReach.inflate(margin);
+      const bool firstReaches = firstReach.overlaps(secondBox);
+      const bool secondReaches = secondReach.overlaps(firstBox);
+      if (!firstReaches && !secondReaches) continue;
+      const auto addVertexContacts = [&](Index fromTriangle, Index toTriangle, const Aabb& toBox) {
+        const auto& target = triangles[toTriangle];
+        const bool targetDirty = isDirty(target[0]) || isDirty(target[1]) || isDirty(target[2]);
+        for (Index vertex : triangles[fromTriangle]) {
+          Aabb box = m_vertexBoxes[vertex];
+          box.inflate(margin);
+          if (box.overlaps(toBox) && (targetDirty || isDirty(vertex)) &&
+              isVertexOwner(vertex, fromTriangle, toTriangle)) {
+            vertexTriangle.push_back({vertex, toTriangle});
+          }
+        }
+      };
+      if (firstReaches) addVertexContacts(pair.first, pair.second, secondBox);
+      if (secondReaches) addVertexContacts(pair.second, pair.first, firstBox);
+      if (!firstReaches) continue;
+      const auto& secondEdges = space.triangleEdges[pair.second];
+      for (Index a : space.triangleEdges[pair.first]) {
+        Aabb first = m_edgeBoxes[a];
+        first.inflate(margin);
+        if (!first.overlaps(secondBox)) continue;
+        for (Index b : secondEdges) {
+          if (first.overlaps(m_edgeBoxes[b]) &&
+              (isDirty(edges[a][0]) || isDirty(edges[a][1]) || isDirty(edges[b][0]) ||
+               isDirty(edges[b][1])) &&
+              isEdgeOwner(a, b, pair)) {
+            edgeEdge.push_back({std::min(a, b), std::max(a, b)});
+          }
+        }
+      }
+    }
+  };
+  m_vertexTriangle.clear();
+  m_edgeEdge.clear();
+  const Index pairCount = Index(m_trianglePairs.size());
+  if (!m_tasks || m_tasks->isSerial() || pairCount <= kGrainTrianglePairs) {
+    collectRange(0, pairCount, m_vertexTriangle, m_edgeEdge);
+    return;
+  }
+  const Index blocks = TaskSystem::blockCount(pairCount, kGrainTrianglePairs);
+  if (m_blockFeatures.size() < blocks) m_blockFeatures.resize(blocks);
+  m_tasks->parallelFor(pairCount, kGrainTrianglePairs, [&](Index begin, Index end, int) {
+    BlockFeatures& block = m_blockFeatures[begin / kGrainTrianglePairs];
+    block.vertexTriangle.clear();
+    block.edgeEdge.clear();
+    collectRange(begin, end, block.vertexTriangle, block.edgeEdge);
+  });
+  for (Index b = 0; b < blocks; ++b) {
+    const BlockFeatures& block = m_blockFeatures[b];
+    m_vertexTriangle.insert(m_vertexTriangle.end(), block.vertexTriangle.begin(),
+                            block.vertexTriangle.end());
+    m_edgeEdge.insert(m_edgeEdge.end(), block.edgeEdge.begin(), block.edgeEdge.end());
+  }
+}
+
+}  // namespace weft

@@ -1,0 +1,75 @@
+// FeaturePairs: the broad phase of the contact space — one AABB tree over every triangle of every
+// cloth, refit per query, and the vertex–triangle and edge–edge feature pairs of the triangle
+// pairs it reports (Bridson, Fedkiw & Anderson 2002, §6: the two kinds of pair that cover every
+// way two triangle meshes can meet).
+//
+// A feature pair is reached through several triangle pairs; it is taken from one of them, its
+// canonical pair (vertex v against triangle B: the lowest triangle around v that shares no vertex
+// with B; edge a against edge b: the lowest pair of their triangles that shares none), so the
+// features come out each once, in the sorted order of the triangle pairs, with no sort. The
+// triangle pairs are found in parallel over fixed blocks and joined in block order: the same
+// lists on any thread count.
+#pragma once
+
+#include "contact/ContactSpace.h"
+
+#include <weft/collision/Bvh.h>
+#include <weft/threading/PerWorker.h>
+#include <weft/threading/TaskSystem.h>
+
+#include <memory>
+#include <vector>
+
+namespace weft {
+
+class FeaturePairs {
+ public:
+  /// Builds the tree over the space's triangles at its current positions, and the adjacency
+  /// tables; allocates (call when the space is rebuilt).
+  void build(const ContactSpace& space, TaskSystem* tasks);
+
+  /// m: leaves whose triangles moved less than this since their last refit keep their boxes
+  /// (Bvh::setRefitMargin; the pairs found do not change). Negative: refit everything.
+  void setRefitMargin(Real margin) { m_bvh.setRefitMargin(margin); }
+
+  /// The feature pairs whose boxes over `from` → `to` (one side inflated by `inflate`) overlap,
+  /// in triangle pairs the space allows (ContactSpace::pairsAllowed). With `dirty` (one flag per
+  /// vertex), only the pairs with a dirty vertex.
+  void find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to, Real inflate,
+            const std::vector<char>* dirty = nullptr);
+
+  /// (vertex, triangle) and (edge, edge) pairs of the last find(), each once.
+  const std::vector<std::array<Index, 2>>& vertexTriangle() const { return m_vertexTriangle; }
+  const std::vector<std::array<Index, 2>>& edgeEdge() const { return m_edgeEdge; }
+
+  /// Tree nodes the refits recomputed and kept since the last call; resets the counts.
+  Bvh::RefitCounts takeRefitCounts() {
+    const Bvh::RefitCounts counts = m_refitCounts;
+    m_refitCounts = {};
+    return counts;
+  }
+
+ private:
+  void findTrianglePairs(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
+                         Real inflate, const std::vector<char>* dirty);
+  void collect(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to, Real margin,
+               const std::vector<char>* dirty);
+
+  TaskSystem* m_tasks = nullptr;
+  Bvh m_bvh;
+  Bvh::RefitCounts m_refitCounts;
+  std::unique_ptr<PerWorker<std::vector<TrianglePair>>> m_workerPairs;
+  std::vector<TrianglePair> m_trianglePairs;
+  std::vector<Index> m_boxHits;
+  std::vector<char> m_dirtyTriangle;
+  std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
+  std::vector<std::array<Index, 2>> m_edgeTriangles;  // the triangles of each edge
+  std::vector<Aabb> m_vertexBoxes, m_triangleBoxes, m_edgeBoxes;
+  struct BlockFeatures {
+    std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
+  };
+  std::vector<BlockFeatures> m_blockFeatures;
+  std::vector<std::array<Index, 2>> m_vertexTriangle, m_edgeEdge;
+};
+
+}  // namespace weft
