@@ -157,7 +157,7 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
     over += length > longest * (1 + tolerance);
     const Vec3 shift = ((longest - length) / length) * delta;
     space.x[i] += shift;
-    ++m_moves[i];
+    m_moves[i] += shift != Vec3::Zero();
   }
   const bool ordered = space.edgeOrder.size() == space.edges.size();
   const bool anchored = space.anchorDistance.size() == space.x.size() && m_followTheLeader;
@@ -197,8 +197,8 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
       const Real fraction = heldStepFraction(delta, shiftB - shiftA, longest);
       space.x[a] += fraction * shiftA;
       space.x[b] += fraction * shiftB;
-      m_moves[a] += !shiftA.isZero() && fraction > 0;
-      m_moves[b] += !shiftB.isZero() && fraction > 0;
+      m_moves[a] += fraction * shiftA != Vec3::Zero();
+      m_moves[b] += fraction * shiftB != Vec3::Zero();
       markIfWithin(space, e);
       continue;
     }
@@ -258,13 +258,13 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   // along its whole path relative to the body over the substep, so that a vertex a fast or thin
   // body passed through is found although it ends clear of it.
   const bool firstVisit = !m_visited[index];
-  Vec3 shift = Vec3::Zero();
+  Vec3 shift = Vec3::Zero();  // the push out, when one is taken
   if (before.distance < thickness || firstVisit) {
     const Vec3 outside =
         firstVisit ? keepOutside(collider, space.startX[i], x, thickness)
                    : keepOutsideFrom(collider.shape, m_lastOutside[index], x, thickness);
-    shift = outside - x;
-    if (!shift.isZero()) {
+    if (!(outside - x).isZero()) {
+      shift = outside - x;
       depth = std::max<Real>(thickness - before.distance, shift.norm());
       x = outside;
       ++m_moves[i];
@@ -272,7 +272,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
     m_visited[index] = 1;
   }
   m_lastOutside[index] = x;
-  const ShapeContact on = shift.isZero() ? before : queryPoint(collider.shape, x);
+  const ShapeContact on = shift == Vec3::Zero() ? before : queryPoint(collider.shape, x);
   m_pushed[index] += std::max<Real>(0, shift.dot(on.normal));
   // Resting on the body now: the edges slide the vertex on it (sweepEdges).
   const bool onSurface = on.distance < (1 + kOnSurfaceShell) * thickness;
@@ -342,7 +342,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   const Vec3 change = correction - applied;
   for (int j = 0; j < 3; ++j) {
     space.x[corner[j]] += (b[j] * space.inverseMass[corner[j]] / weight) * change;
-    m_moves[corner[j]] += b[j] > 0 && !change.isZero();
+    m_moves[corner[j]] += b[j] != 0 && change != Vec3::Zero();
   }
   m_friction[index] = correction;
   return std::max(depth, change.norm());
@@ -360,10 +360,10 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
     const Vec3 lambda = relativeChange / weight;
     for (int k = 0; k < 4; ++k) {
       const Index i = contact.vertices[k];
-      if (space.inverseMass[i] > 0 && contact.weights[k] != 0) {
-        space.x[i] += (contact.weights[k] * inverseMass) * lambda;
-        m_moves[i] += !lambda.isZero();
-      }
+      if (space.inverseMass[i] == 0) continue;
+      const Vec3 shift = (contact.weights[k] * inverseMass) * lambda;
+      space.x[i] += shift;
+      m_moves[i] += shift != Vec3::Zero();
     }
   };
   if (shortfall > 0) {
