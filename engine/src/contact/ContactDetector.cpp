@@ -59,15 +59,9 @@ void ContactDetector::selectNear(const ContactSpace& space,
                                  Real margin, DetectionCounts& counts) {
   m_near.clear();
   if (colliders.empty()) return;
-  Real thickness = 0;
-  for (const ContactOwner& owner : space.owners) thickness = std::max(thickness, owner.thickness);
+  const Real thickness = space.maxThickness();
   // The paths of the free vertices; for a moving body, their starts carried with it too.
-  Aabb path = Aabb::empty();
-  for (Index i = 0; i < space.vertexCount(); ++i) {
-    if (space.inverseMass[i] == 0) continue;
-    path.expand(space.startX[i]);
-    path.expand(end[i]);
-  }
+  const Aabb path = space.movablePaths(end);
   const Real reach = thickness * (1 + 1e-6) + margin + 1e-9;
   for (Index k = 0; k < Index(colliders.size()); ++k) {
     const ColliderFrame& collider = colliders[k];
@@ -309,9 +303,7 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
 }
 
 void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
-  Real maxThickness = 0;
-  for (const ContactOwner& owner : space.owners) maxThickness = std::max(maxThickness, owner.thickness);
-  m_pairMargin = kPairReach * maxThickness;
+  m_pairMargin = kPairReach * space.maxThickness();
   m_features.find(space, space.startX, space.x, m_pairMargin);
   const auto& vertexTriangle = m_features.vertexTriangle();
   const auto& edgeEdgePairs = m_features.edgeEdge();

@@ -166,6 +166,22 @@ void ContactSpace::scatter() const {
   }
 }
 
+Real ContactSpace::maxThickness() const {
+  Real thickness = 0;
+  for (const ContactOwner& o : owners) thickness = std::max(thickness, o.thickness);
+  return thickness;
+}
+
+Aabb ContactSpace::movablePaths(std::span<const Vec3> end) const {
+  Aabb paths = Aabb::empty();
+  for (Index i = 0; i < vertexCount(); ++i) {
+    if (inverseMass[i] == 0) continue;
+    paths.expand(startX[i]);
+    paths.expand(end[i]);
+  }
+  return paths;
+}
+
 Real ContactSpace::pairThickness(Index a, Index b) const {
   return std::max(owners[owner[a]].thickness, owners[owner[b]].thickness);
 }

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <weft/Math.h>
+#include <weft/collision/Aabb.h>
 
 #include <array>
 #include <span>
@@ -90,6 +91,11 @@ class ContactSpace {
   bool faceContacts(Index vertex) const {
     return m_faceContacts.empty() || m_faceContacts[owner[vertex]] != 0;
   }
+
+  /// m, the largest thickness of the owners (0 with none).
+  Real maxThickness() const;
+  /// The box of the paths of the movable vertices, from startX to `end`.
+  Aabb movablePaths(std::span<const Vec3> end) const;
 
   /// Thickness (m) and friction of a pair of vertices' owners: the larger thickness and the
   /// geometric mean of the frictions (one owner: its own values).

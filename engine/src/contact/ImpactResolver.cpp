@@ -78,14 +78,8 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
                                          std::span<const ColliderFrame> colliders) {
   m_near.clear();
   if (colliders.empty()) return 0;
-  Real thickness = 0;
-  for (const ContactOwner& owner : space.owners) thickness = std::max(thickness, owner.thickness);
-  Aabb path = Aabb::empty();
-  for (Index i = 0; i < space.vertexCount(); ++i) {
-    if (space.inverseMass[i] == 0) continue;
-    path.expand(space.startX[i]);
-    path.expand(space.x[i]);
-  }
+  const Real thickness = space.maxThickness();
+  const Aabb path = space.movablePaths(space.x);
   for (Index k = 0; k < Index(colliders.size()); ++k) {
     Aabb box = path;
     if (!colliders[k].still()) {
