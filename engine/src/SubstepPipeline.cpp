@@ -24,7 +24,6 @@ constexpr Real kColliderMarginPerEdge = 0.5;
 // its limit.
 constexpr int kStrainRounds = 2;
 
-// Adds the counters the substeps of an attempt collect to the frame's statistics.
 // Whether `strain` is past the cloth's strain limit + kStrainLimitSlack (no limit: never).
 bool pastLimit(const Cloth& cloth, Real strain) {
   const Real limit = cloth.settings().material.strainLimit;
@@ -33,8 +32,7 @@ bool pastLimit(const Cloth& cloth, Real strain) {
 
 // The strain `cloth` ends the frame with, into the stats; a cloth past its limit is reported,
 // never passed off as ok (StepStatus::StrainLimitExceeded).
-void reportStrain(const Cloth& cloth, StepStats& stats) {
-  const Real strain = cloth.maxStrain();
+void reportStrain(const Cloth& cloth, Real strain, StepStats& stats) {
   stats.maxStrain = std::max(stats.maxStrain, strain);
   if (pastLimit(cloth, strain)) {
     ++stats.clothsOverStrainLimit;
@@ -42,6 +40,7 @@ void reportStrain(const Cloth& cloth, StepStats& stats) {
   }
 }
 
+// Adds the counters the substeps of an attempt collect to the frame's statistics.
 void addSubstepCounters(const StepStats& from, StepStats& to) {
   to.assemblyMs += from.assemblyMs;
   to.solveMs += from.solveMs;
@@ -96,6 +95,7 @@ void SubstepPipeline::rebuild(std::span<Cloth* const> cloths) {
   m_yanked.assign(cloths.size(), 0);
   m_startStrain.assign(cloths.size(), 0);
   m_startKinetic.assign(cloths.size(), 0);
+  m_endStrain.assign(cloths.size(), 0);
   m_reports.assign(cloths.size(), IntegratorReport{});
   m_pairContacts.assign(cloths.size(), 0);
   m_selfContacts.resize(cloths.size());
@@ -135,7 +135,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
   }
   if (!anyStepping) {
     for (Cloth* cloth : cloths) {
-      reportStrain(*cloth, stats);
+      reportStrain(*cloth, cloth->maxStrain(), stats);
       stats.potentialEnergy += cloth->lastPotential();
     }
     return;
@@ -180,7 +180,8 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
       for (std::size_t c = 0; c < cloths.size() && failure == HealthFailure::None; ++c) {
         if (!m_stepping[c]) continue;
         const Cloth& cloth = *cloths[c];
-        failure = checkFrameHealth(cloth, m_startStrain[c], m_startKinetic[c], cloth.maxStrain(),
+        m_endStrain[c] = cloth.maxStrain();
+        failure = checkFrameHealth(cloth, m_startStrain[c], m_startKinetic[c], m_endStrain[c],
                                    cloth.kineticEnergy(), m_frameStartMotions);
       }
     }
@@ -232,7 +233,11 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     const ClothStageCounts counts = cloth.takeStageCounts();
     stats.bendingAssemblies += counts.bendingAssemblies;
     stats.dampingJacobians += counts.dampingJacobians;
-    reportStrain(cloth, stats);
+    // A rolled-back cloth is back at its frame start, whose strain was measured then.
+    const Real strain = !m_stepping[c] ? cloth.maxStrain()
+                        : rolledBack   ? m_startStrain[c]
+                                       : m_endStrain[c];
+    reportStrain(cloth, strain, stats);
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
     stats.potentialEnergy += cloth.lastPotential();
@@ -253,7 +258,7 @@ Index SubstepPipeline::strainRetryLimit(std::span<Cloth* const> cloths, const St
 
 bool SubstepPipeline::pastStrainLimit(std::span<Cloth* const> cloths) const {
   for (std::size_t c = 0; c < cloths.size(); ++c) {
-    if (m_stepping[c] && pastLimit(*cloths[c], cloths[c]->maxStrain())) return true;
+    if (m_stepping[c] && pastLimit(*cloths[c], m_endStrain[c])) return true;
   }
   return false;
 }

@@ -65,7 +65,7 @@ class SubstepPipeline {
   // strainRetrySubsteps of the stepping cloths, 0 when any has fixed substeps or the plan fixes
   // them (a budget's plan must replay as planned).
   Index strainRetryLimit(std::span<Cloth* const> cloths, const StepPlan& plan) const;
-  // Whether a stepping cloth with a strain limit ends past it + kStrainLimitSlack.
+  // Whether a stepping cloth with a strain limit ends past it + kStrainLimitSlack (m_endStrain).
   bool pastStrainLimit(std::span<Cloth* const> cloths) const;
   // One substep (see the file comment).
   HealthFailure substep(Real t, Real h, Index index, StepStats& stats);
@@ -93,6 +93,7 @@ class SubstepPipeline {
   Vec3Array m_solvedPositions;                   // x after the solve (the detection's end)
   std::vector<Index> m_constrainedCollider;      // per vertex, kInvalidIndex: none
   std::vector<Real> m_startStrain, m_startKinetic;  // per cloth, at the frame start
+  std::vector<Real> m_endStrain;  // per stepping cloth, at the end of the last healthy attempt
   std::vector<IntegratorReport> m_reports;       // per cloth, this attempt
   std::vector<Index> m_pairContacts;             // per cloth, this substep
   std::vector<std::vector<SelfContactFeatures>> m_selfContacts;  // per cloth, this substep

@@ -46,13 +46,18 @@ void pullRightSide(World& world, ClothId cloth, const ClothSettings& settings, R
   ASSERT_TRUE(world.setPinTargets(cloth, targets).ok());
 }
 
+// The strip with `settings` (pinnedAtBothEnds) in `world`, its right pins pulled by `pull` times
+// its width.
+void addPulledStrip(World& world, const ClothSettings& settings, Real pull) {
+  const ClothId cloth = world.createCloth(strip(), settings).value();
+  pullRightSide(world, cloth, settings, pull * kWidth);
+}
+
 TEST(StrainLimitStatus, PinsPulledApartPastTheLimitAreFlaggedInEveryFrame) {
   // The pins 1.3 times the strip's length apart: every edge along it must stretch 0.3, three
   // times the limit of 0.10.
   World world;
-  const ClothSettings settings = pinnedAtBothEnds(0.1);
-  const ClothId cloth = world.createCloth(strip(), settings).value();
-  pullRightSide(world, cloth, settings, 0.3 * kWidth);
+  addPulledStrip(world, pinnedAtBothEnds(0.1), 0.3);
   for (int frame = 0; frame < 30; ++frame) {
     const StepStatus status = world.step(kFrame);
     ASSERT_GT(world.stats().maxStrain, 0.1 + kStrainLimitSlack) << "frame " << frame;
@@ -65,9 +70,7 @@ TEST(StrainLimitStatus, PinsPulledApartPastTheLimitAreFlaggedInEveryFrame) {
 TEST(StrainLimitStatus, ASheetWithinItsLimitIsNeverFlagged) {
   // The same strip pulled by 5 %, within the limit: the limit is met, nothing is reported.
   World world;
-  const ClothSettings settings = pinnedAtBothEnds(0.1);
-  const ClothId cloth = world.createCloth(strip(), settings).value();
-  pullRightSide(world, cloth, settings, 0.05 * kWidth);
+  addPulledStrip(world, pinnedAtBothEnds(0.1), 0.05);
   for (int frame = 0; frame < 60; ++frame) {
     const StepStatus status = world.step(kFrame);
     EXPECT_LE(world.stats().maxStrain, 0.1 + kStrainLimitSlack) << "frame " << frame;
@@ -78,9 +81,7 @@ TEST(StrainLimitStatus, ASheetWithinItsLimitIsNeverFlagged) {
 
 TEST(StrainLimitStatus, AClothWithoutALimitHasNoneToExceed) {
   World world;
-  const ClothSettings settings = pinnedAtBothEnds(0);
-  const ClothId cloth = world.createCloth(strip(), settings).value();
-  pullRightSide(world, cloth, settings, 0.3 * kWidth);
+  addPulledStrip(world, pinnedAtBothEnds(0), 0.3);
   for (int frame = 0; frame < 10; ++frame) {
     const StepStatus status = world.step(kFrame);
     EXPECT_GT(world.stats().maxStrain, 0.1 + kStrainLimitSlack) << "frame " << frame;
@@ -97,8 +98,7 @@ TEST(StrainLimitStatus, AFramePastTheLimitIsRedoneWithTwiceTheSubstepsUpToItsCap
     World world;
     ClothSettings settings = pinnedAtBothEnds(0.1);
     settings.solver.strainRetrySubsteps = cap;
-    const ClothId cloth = world.createCloth(strip(), settings).value();
-    pullRightSide(world, cloth, settings, 0.3 * kWidth);
+    addPulledStrip(world, settings, 0.3);
     (void)world.step(kFrame);
     for (int frame = 1; frame < 6; ++frame) {
       const StepStatus status = world.step(kFrame);
@@ -111,9 +111,7 @@ TEST(StrainLimitStatus, AFramePastTheLimitIsRedoneWithTwiceTheSubstepsUpToItsCap
 
 TEST(StrainLimitStatus, AFrameWithinTheLimitIsNotRedone) {
   World world;
-  const ClothSettings settings = pinnedAtBothEnds(0.1);
-  const ClothId cloth = world.createCloth(strip(), settings).value();
-  pullRightSide(world, cloth, settings, 0.05 * kWidth);
+  addPulledStrip(world, pinnedAtBothEnds(0.1), 0.05);
   for (int frame = 0; frame < 30; ++frame) {
     (void)world.step(kFrame);
     EXPECT_EQ(world.stats().strainRetries, 0u) << "frame " << frame;

@@ -1,29 +1,15 @@
 #include "contact/ContactDetector.h"
 
-#include <weft/collision/Aabb.h>
 #include <weft/collision/ContinuousCollision.h>
 #include <weft/collision/Proximity.h>
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
 #include <cmath>
-#include <initializer_list>
 #include <variant>
 
 namespace weft {
 namespace {
-
-// Whether the boxes around two features' start positions come within `reach` of each other: when
-// they do not, the features are farther apart than `reach`, and the closest points need not be
-// worked out.
-bool withinReach(std::initializer_list<Index> first, std::initializer_list<Index> second,
-                 const Vec3Array& x, Real reach) {
-  Aabb a = Aabb::empty(), b = Aabb::empty();
-  for (Index i : first) a.expand(x[i]);
-  for (Index i : second) b.expand(x[i]);
-  a.inflate(reach);
-  return a.overlaps(b);
-}
 
 // A vertex resting on a collider within this fraction of the thickness beyond it is constrained
 // in the solve: every vertex of a cloth lying on a body then takes its own weight from the solve.
@@ -323,7 +309,8 @@ void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
     const Vec3 n0 = (x0[c[1]] - x0[c[0]]).cross(x0[c[2]] - x0[c[0]]);
     const Vec3 n1 = (x1[c[1]] - x1[c[0]]).cross(x1[c[2]] - x1[c[0]]);
     const bool sideChanged = n0.dot(x0[vertex] - x0[c[0]]) * n1.dot(x1[vertex] - x1[c[0]]) <= 0;
-    if (!sideChanged && !withinReach({vertex}, {c[0], c[1], c[2]}, x0, kPairReach * thickness)) {
+    if (!sideChanged &&
+        !featureBoxesWithin({vertex}, {c[0], c[1], c[2]}, x0, x0, kPairReach * thickness)) {
       return false;
     }
     const TriangleClosestPoint start = closestPointOnTriangle(x0[vertex], x0[c[0]], x0[c[1]], x0[c[2]]);
@@ -365,7 +352,8 @@ void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
     const Vec3 n0 = (x0[p[1]] - x0[p[0]]).cross(x0[q[1]] - x0[q[0]]);
     const Vec3 n1 = (x1[p[1]] - x1[p[0]]).cross(x1[q[1]] - x1[q[0]]);
     const bool sideChanged = n0.dot(x0[p[0]] - x0[q[0]]) * n1.dot(x1[p[0]] - x1[q[0]]) <= 0;
-    if (!sideChanged && !withinReach({p[0], p[1]}, {q[0], q[1]}, x0, kPairReach * thickness)) {
+    if (!sideChanged &&
+        !featureBoxesWithin({p[0], p[1]}, {q[0], q[1]}, x0, x0, kPairReach * thickness)) {
       return false;
     }
     const SegmentClosestPoints start = closestPointsOnSegments(x0[p[0]], x0[p[1]], x0[q[0]], x0[q[1]]);

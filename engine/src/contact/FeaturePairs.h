@@ -17,10 +17,25 @@
 #include <weft/threading/PerWorker.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
 namespace weft {
+
+/// Whether the boxes of two features' paths (the positions of vertices `first`, and of `second`,
+/// from `from` to `to`) come within `reach` (m) of each other. When they do not, no point of one
+/// feature comes that close to the other over the path, and the exact test need not run. Pass
+/// the same positions as `from` and `to` for the features at one time.
+inline bool featureBoxesWithin(std::initializer_list<Index> first,
+                               std::initializer_list<Index> second, const Vec3Array& from,
+                               const Vec3Array& to, Real reach) {
+  Aabb a = Aabb::empty(), b = Aabb::empty();
+  for (Index i : first) a.expand(Aabb::fromCorners(from[i], to[i]));
+  for (Index i : second) b.expand(Aabb::fromCorners(from[i], to[i]));
+  a.inflate(reach);
+  return a.overlaps(b);
+}
 
 class FeaturePairs {
  public:

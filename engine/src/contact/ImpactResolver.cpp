@@ -1,6 +1,5 @@
 #include "contact/ImpactResolver.h"
 
-#include <weft/collision/Aabb.h>
 #include <weft/collision/ContinuousCollision.h>
 #include <weft/threading/Profiler.h>
 
@@ -9,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-#include <initializer_list>
 
 namespace weft {
 namespace {
@@ -35,18 +33,6 @@ constexpr Real kHeldInverseMassScale = 1e-3;
 // have to move at Δu / w_k (a point on a face whose pinned corners collapsed together flew at
 // 10¹⁵ m/s). The impact zones, which move with the pins, take such a pair.
 constexpr Real kSmallestMovableWeight = 1e-3;
-
-// Whether the boxes the two features sweep over the step, grown by the swept tests' reach,
-// overlap: when they do not, no swept test of the pair can find a contact, and most candidate
-// pairs the detection's wider margin kept fail here for a few comparisons instead of a cubic.
-bool sweptBoxesMeet(std::initializer_list<Index> first, std::initializer_list<Index> second,
-                    const Vec3Array& start, const Vec3Array& end) {
-  Aabb a = Aabb::empty(), b = Aabb::empty();
-  for (Index i : first) a.expand(Aabb::fromCorners(start[i], end[i]));
-  for (Index i : second) b.expand(Aabb::fromCorners(start[i], end[i]));
-  a.inflate(kSweptInflate);
-  return a.overlaps(b);
-}
 
 Index findRoot(std::vector<Index>& parent, Index vertex) {
   while (parent[vertex] != vertex) {
@@ -298,7 +284,10 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
       const std::array<Index, 3>& c = space.triangles[triangle];
       // A pair without a dirty vertex tests as it did last time: negative.
       if (!m_dirty[vertex] && !m_dirty[c[0]] && !m_dirty[c[1]] && !m_dirty[c[2]]) return false;
-      if (!sweptBoxesMeet({vertex}, {c[0], c[1], c[2]}, start, m_end)) return false;
+      // Most candidates the detection's wider margin kept end here, for a few comparisons.
+      if (!featureBoxesWithin({vertex}, {c[0], c[1], c[2]}, start, m_end, kSweptInflate)) {
+        return false;
+      }
       const std::array<Vec3, 3> triangleStart{start[c[0]], start[c[1]], start[c[2]]};
       const std::array<Vec3, 3> triangleEnd{m_end[c[0]], m_end[c[1]], m_end[c[2]]};
       const std::optional<VertexTriangleImpact> hit =
@@ -322,7 +311,7 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
     const std::array<Index, 2>& p = space.edges[firstEdge];
     const std::array<Index, 2>& q = space.edges[secondEdge];
     if (!m_dirty[p[0]] && !m_dirty[p[1]] && !m_dirty[q[0]] && !m_dirty[q[1]]) return false;
-    if (!sweptBoxesMeet({p[0], p[1]}, {q[0], q[1]}, start, m_end)) return false;
+    if (!featureBoxesWithin({p[0], p[1]}, {q[0], q[1]}, start, m_end, kSweptInflate)) return false;
     const std::optional<EdgeEdgeImpact> hit =
         sweptEdgeEdge({start[p[0]], start[p[1]]}, {m_end[p[0]], m_end[p[1]]},
                       {start[q[0]], start[q[1]]}, {m_end[q[0]], m_end[q[1]]});
