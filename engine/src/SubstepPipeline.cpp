@@ -96,6 +96,7 @@ void SubstepPipeline::rebuild(std::span<Cloth* const> cloths) {
   m_startStrain.assign(cloths.size(), 0);
   m_startKinetic.assign(cloths.size(), 0);
   m_endStrain.assign(cloths.size(), 0);
+  m_strainRetriesFailed.assign(cloths.size(), 0);
   m_reports.assign(cloths.size(), IntegratorReport{});
   m_pairContacts.assign(cloths.size(), 0);
   m_selfContacts.resize(cloths.size());
@@ -169,8 +170,8 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
   // Attempts: a frame that fails a health check is restored and retried with twice the
   // substeps; after kMaxHealthRetries it is rolled back. A healthy frame that leaves a cloth past
   // its strain limit is redone with twice the substeps too, within strainRetrySubsteps, when the
-  // substeps are automatic: the contacts of a squeeze move cloth several thicknesses a substep at
-  // 60 Hz, more than one projection can untangle from the limits.
+  // substeps are automatic and the retry can help (strainRetryHelps): the contacts of a squeeze
+  // move cloth several thicknesses a substep at 60 Hz, more than one projection can untangle.
   const Index strainRetryCap = strainRetryLimit(cloths, plan);
   for (int attempt = 0;; ++attempt) {
     StepStats attemptStats;
@@ -185,9 +186,11 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
                                    cloth.kineticEnergy(), m_frameStartMotions);
       }
     }
-    if (failure == HealthFailure::None && substeps * 2 <= strainRetryCap && pastStrainLimit(cloths)) {
+    if (failure == HealthFailure::None && substeps * 2 <= strainRetryCap &&
+        strainRetryHelps(cloths)) {
       for (std::size_t c = 0; c < cloths.size(); ++c) {
-        if (m_stepping[c]) cloths[c]->restoreFrameStart();
+        if (!m_stepping[c]) continue;
+        cloths[c]->restoreFrameStart();
       }
       ++stats.strainRetries;
       substeps *= 2;
@@ -238,6 +241,9 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
                         : rolledBack   ? m_startStrain[c]
                                        : m_endStrain[c];
     reportStrain(cloth, strain, stats);
+    if (m_stepping[c]) {
+      m_strainRetriesFailed[c] = pastLimit(cloth, strain) && (stats.strainRetries > 0 || m_strainRetriesFailed[c]);
+    }
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());
     stats.potentialEnergy += cloth.lastPotential();
@@ -256,9 +262,10 @@ Index SubstepPipeline::strainRetryLimit(std::span<Cloth* const> cloths, const St
   return cap == std::numeric_limits<Index>::max() ? 0 : cap;
 }
 
-bool SubstepPipeline::pastStrainLimit(std::span<Cloth* const> cloths) const {
+bool SubstepPipeline::strainRetryHelps(std::span<Cloth* const> cloths) const {
   for (std::size_t c = 0; c < cloths.size(); ++c) {
-    if (m_stepping[c] && pastLimit(*cloths[c], m_endStrain[c])) return true;
+    if (!m_stepping[c] || !pastLimit(*cloths[c], m_endStrain[c])) continue;
+    if (!(m_strainRetriesFailed[c] && pastLimit(*cloths[c], m_startStrain[c]))) return true;
   }
   return false;
 }

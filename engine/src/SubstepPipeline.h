@@ -65,8 +65,10 @@ class SubstepPipeline {
   // strainRetrySubsteps of the stepping cloths, 0 when any has fixed substeps or the plan fixes
   // them (a budget's plan must replay as planned).
   Index strainRetryLimit(std::span<Cloth* const> cloths, const StepPlan& plan) const;
-  // Whether a stepping cloth with a strain limit ends past it + kStrainLimitSlack (m_endStrain).
-  bool pastStrainLimit(std::span<Cloth* const> cloths) const;
+  // Whether redoing the frame with twice the substeps may help: a stepping cloth ends past its
+  // strain limit + kStrainLimitSlack, unless it started past it too and the retries of the frames
+  // before left it there (pins or a tangle hold it: more substeps change nothing).
+  bool strainRetryHelps(std::span<Cloth* const> cloths) const;
   // One substep (see the file comment).
   HealthFailure substep(Real t, Real h, Index index, StepStats& stats);
   void pose(Index index, Real h);
@@ -94,6 +96,8 @@ class SubstepPipeline {
   std::vector<Index> m_constrainedCollider;      // per vertex, kInvalidIndex: none
   std::vector<Real> m_startStrain, m_startKinetic;  // per cloth, at the frame start
   std::vector<Real> m_endStrain;  // per stepping cloth, at the end of the last healthy attempt
+  // Per cloth: it ended its last stepped frames past its strain limit, retries failing to help.
+  std::vector<char> m_strainRetriesFailed;
   std::vector<IntegratorReport> m_reports;       // per cloth, this attempt
   std::vector<Index> m_pairContacts;             // per cloth, this substep
   std::vector<std::vector<SelfContactFeatures>> m_selfContacts;  // per cloth, this substep
