@@ -1,12 +1,14 @@
 #include "Cloth.h"
 
 #include "ClothSettingsValidation.h"
+#include "HealthMonitor.h"
 #include "solver/MulticolorOrdering.h"
 
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numeric>
 
@@ -68,6 +70,14 @@ Cloth::Cloth(std::shared_ptr<const ClothModel> model, const ClothSettings& setti
   }
   m_pinnedMask.assign(n, 0);
   for (Index p : pins) m_pinnedMask[p] = 1;
+  {
+    std::vector<Index> slotOf(n, kInvalidIndex);
+    for (std::size_t k = 0; k < pins.size(); ++k) slotOf[pins[k]] = Index(k);
+    for (const Edge& edge : m_model->edges()) {
+      const Index a = slotOf[edge.vertices[0]], b = slotOf[edge.vertices[1]];
+      if (a != kInvalidIndex && b != kInvalidIndex) m_pinnedEdges.push_back({a, b, edge.restLength});
+    }
+  }
   buildSystemRows();
   m_pinStart.resize(pins.size());
   for (std::size_t k = 0; k < pins.size(); ++k) m_pinStart[k] = m_positions[pins[k]];
@@ -293,6 +303,25 @@ Status Cloth::setPinTargets(std::span<const Vec3> targets) {
     }
   }
   m_pinEnd.assign(targets.begin(), targets.end());
+  return Status::success();
+}
+
+Status Cloth::checkPinnedEdges(std::span<const Vec3> targets) const {
+  if (targets.size() != m_pinEnd.size()) return Status::success();  // setPinTargets names it
+  for (const PinnedEdge& edge : m_pinnedEdges) {
+    const Real length = (targets[edge.slots[1]] - targets[edge.slots[0]]).norm();
+    // A non-finite target is setPinTargets' to name.
+    if (!std::isfinite(length) || !(length > (1 + kDivergedStrain) * edge.restLength)) continue;
+    char figures[128];
+    std::snprintf(figures, sizeof figures, "%.3g m apart, %.3g times the %.3g m edge between them",
+                  length, length / edge.restLength, edge.restLength);
+    return Error{"setPinTargets: the targets of pinned vertices " +
+                 std::to_string(m_settings.pinnedVertices[edge.slots[0]]) + " and " +
+                 std::to_string(m_settings.pinnedVertices[edge.slots[1]]) + " are " + figures +
+                 ", which no cloth survives (a frame that stretches an edge past " +
+                 std::to_string(int(1 + kDivergedStrain)) +
+                 " times its rest length is rolled back); move them together or unpin one"};
+  }
   return Status::success();
 }
 

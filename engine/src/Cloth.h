@@ -20,6 +20,7 @@
 
 #include <weft/engine/World.h>
 
+#include <array>
 #include <memory>
 #include <optional>
 
@@ -129,6 +130,9 @@ class Cloth final : public DynamicSystem {
   Real meanEdgeLength() const { return m_meanEdgeLength; }
 
   Status setPinTargets(std::span<const Vec3> targets);
+  /// Refuses targets that stretch an edge between two pinned vertices past what the health check
+  /// lets a frame end with (kDivergedStrain): no substeps could keep such a frame.
+  Status checkPinnedEdges(std::span<const Vec3> targets) const;
   /// N per vertex, added to every evaluation until changed; an empty span removes them.
   Status setExternalForces(std::span<const Vec3> forces);
   const Vec3Array& pinTargets() const { return m_pinEnd; }
@@ -214,6 +218,11 @@ class Cloth final : public DynamicSystem {
   std::vector<Index> m_pinnedSorted;   // pinned vertices, increasing
   std::vector<Index> m_pinSlotOfSorted;  // index into settings.pinnedVertices per sorted pin
   std::vector<char> m_pinnedMask;
+  struct PinnedEdge {
+    std::array<Index, 2> slots;  // into settings.pinnedVertices
+    Real restLength;
+  };
+  std::vector<PinnedEdge> m_pinnedEdges;  // edges whose both ends are pinned
   std::vector<Real> m_inverseMasses;
   Vec3Array m_pinStart, m_pinEnd;      // targets at frame start and end, in settings order
   Real m_frameStart = 0, m_frameLength = 1;

@@ -12,8 +12,6 @@ namespace {
 // m/s: no cloth motion comes near it (a 250 m/s projectile drags cloth at 250 m/s), while a
 // blown-up explicit step passes it within a few substeps.
 constexpr Real kDivergedSpeed = kMaxSpeed;
-// Strain (l / l_rest − 1) of a diverged integration: cloth tears long before.
-constexpr Real kDivergedStrain = 99;
 // Kinetic energy beyond this multiple of what the frame could supply: energy from nowhere.
 constexpr Real kEnergyJumpFactor = 100;
 // m/s: a speed scale below which no energy is suspicious (round-off on a cloth at rest).

@@ -24,6 +24,9 @@ namespace weft {
 
 class Cloth;
 
+/// Strain (l / l_rest − 1) of a diverged integration: cloth tears long before.
+inline constexpr Real kDivergedStrain = 99;
+
 /// Retries of a failed frame, each with twice the substeps: up to 8 times the planned number.
 inline constexpr int kMaxHealthRetries = 3;
 

@@ -342,6 +342,7 @@ Status World::setPinTargets(ClothId id, std::span<const Vec3> targets) {
   if (targets.size() == slot->cloth->pinTargets().size()) {
     if (Status reach = checkReach(targets, "setPinTargets", "target"); !reach.ok()) return reach;
   }
+  if (Status torn = slot->cloth->checkPinnedEdges(targets); !torn.ok()) return torn;
   return slot->cloth->setPinTargets(targets);
 }
 

@@ -13,6 +13,7 @@
 //     edge length per substep, so a cloth whose pins jump 10 m is hauled after them within its
 //     strain limit in that frame (in one substep the limiter stopped at its iteration cap with
 //     almost every edge far over);
+//   - targets that stretch an edge between two pins past what a frame may end with are refused;
 //   - a sleeping cloth reports the potential energy of its last stepped frame, not 0 J (the stress
 //     scene measured its settled energy on a sleeping cloth and got a baseline of 0 J).
 #include <weft/engine/FabricPresets.h>
@@ -427,36 +428,78 @@ TEST(PinTeleport, ANegativeOrNonFiniteTeleportAngleIsRefusedByName) {
 }
 
 TEST(PinTeleport, OnePinYankedAloneOrAShortJumpIsDraggedNotCarried) {
+  // Each in a world of its own: the three cloths would lie on one another.
   const auto model = sheet();
-  World world;
   ClothSettings settings = hangingCotton();
   settings.selfCollision = false;
-  const ClothId yanked = world.createCloth(model, settings).value();
-  const ClothId shortJump = world.createCloth(model, settings).value();
-  const ClothId longJump = world.createCloth(model, settings).value();
   const Real size = model->characteristicLength();
-  // One corner pin yanked 10 m: the substep rule follows it.
-  std::vector<Vec3> targets = world.pinTargets(yanked).value();
-  targets[0].x() += 10.0;
-  ASSERT_TRUE(world.setPinTargets(yanked, targets).ok());
-  EXPECT_EQ(world.plannedSubsteps(yanked, kFrameDt).value(),
-            Index(std::ceil(10.0 / meanEdgeLength(*model) * (1 - 1e-9))));
+  // One corner pin yanked 2 m (40 times the edge to its neighbour pin): the substep rule follows
+  // it, and the frame ends with the cloth torn between the pins as far as they demand, flagged.
+  World yankedWorld;
+  const ClothId yanked = yankedWorld.createCloth(model, settings).value();
+  std::vector<Vec3> targets = yankedWorld.pinTargets(yanked).value();
+  targets[0].x() += 2.0;
+  ASSERT_TRUE(yankedWorld.setPinTargets(yanked, targets).ok());
+  EXPECT_EQ(yankedWorld.plannedSubsteps(yanked, kFrameDt).value(),
+            Index(std::ceil(2.0 / meanEdgeLength(*model) * (1 - 1e-9))));
+  const StepStatus yankedStatus = yankedWorld.step(kFrameDt);
+  EXPECT_EQ(yankedWorld.stats().teleportedCloths, 0u);
+  EXPECT_TRUE(hasFlag(yankedStatus, StepStatus::StrainLimitExceeded)) << describe(yankedStatus);
+  EXPECT_FALSE(hasFlag(yankedStatus, StepStatus::RolledBack)) << describe(yankedStatus);
+  EXPECT_EQ(yankedWorld.positions(yanked).value()[settings.pinnedVertices[0]], targets[0]);
   // Every pin moving 0.9 of the cloth's size: dragged (more than one edge, so more substeps).
-  targets = world.pinTargets(shortJump).value();
+  World shortWorld;
+  const ClothId shortJump = shortWorld.createCloth(model, settings).value();
+  targets = shortWorld.pinTargets(shortJump).value();
   for (Vec3& target : targets) target.z() += 0.9 * size;
-  ASSERT_TRUE(world.setPinTargets(shortJump, targets).ok());
-  EXPECT_EQ(world.plannedSubsteps(shortJump, kFrameDt).value(),
+  ASSERT_TRUE(shortWorld.setPinTargets(shortJump, targets).ok());
+  EXPECT_EQ(shortWorld.plannedSubsteps(shortJump, kFrameDt).value(),
             Index(std::ceil(0.9 * size / meanEdgeLength(*model) * (1 - 1e-9))));
+  shortWorld.step(kFrameDt);
+  EXPECT_EQ(shortWorld.stats().teleportedCloths, 0u);
+  // Its far edge lags behind its pins.
+  EXPECT_LT(shortWorld.positions(shortJump).value()[0].z(), 0.9 * size - 1e-3);
   // 1.1 of its size: carried, one substep.
-  targets = world.pinTargets(longJump).value();
+  World longWorld;
+  const ClothId longJump = longWorld.createCloth(model, settings).value();
+  targets = longWorld.pinTargets(longJump).value();
   for (Vec3& target : targets) target.z() += 1.1 * size;
-  ASSERT_TRUE(world.setPinTargets(longJump, targets).ok());
-  EXPECT_EQ(world.plannedSubsteps(longJump, kFrameDt).value(), 1);
+  ASSERT_TRUE(longWorld.setPinTargets(longJump, targets).ok());
+  EXPECT_EQ(longWorld.plannedSubsteps(longJump, kFrameDt).value(), 1);
+  longWorld.step(kFrameDt);
+  EXPECT_EQ(longWorld.stats().teleportedCloths, 1u);
+  EXPECT_NEAR(longWorld.positions(longJump).value()[0].z(), 1.1 * size, 1e-3);
+}
+
+TEST(PinTeleport, PinTargetsThatTearAnEdgeBetweenPinsAreRefusedByName) {
+  // One corner of the pinned top row yanked 10 m: the edge to its neighbour pin would be 200
+  // times its rest length, which the health check rolls back however many substeps are taken.
+  World world;
+  ClothSettings settings = hangingCotton();
+  const ClothId cloth = world.createCloth(sheet(), settings).value();
   world.step(kFrameDt);
-  EXPECT_EQ(world.stats().teleportedCloths, 1u);
-  // The yanked and short-jump cloths were dragged: their far edge lags behind its pins.
-  EXPECT_LT(world.positions(shortJump).value()[0].z(), 0.9 * size - 1e-3);
-  EXPECT_NEAR(world.positions(longJump).value()[0].z(), 1.1 * size, 1e-3);
+  const std::vector<Vec3> before = world.pinTargets(cloth).value();
+  const std::vector<Vec3> positions(world.positions(cloth).value().begin(),
+                                    world.positions(cloth).value().end());
+  std::vector<Vec3> targets = before;
+  targets[0].x() += 10.0;
+  const Status torn = world.setPinTargets(cloth, targets);
+  ASSERT_FALSE(torn.ok());
+  const std::string& message = torn.error().message;
+  for (const std::string& named :
+       {std::to_string(settings.pinnedVertices[0]), std::to_string(settings.pinnedVertices[1]),
+        std::string("unpin")}) {
+    EXPECT_NE(message.find(named), std::string::npos) << message;
+  }
+  // Nothing changed: the targets are the old ones and the cloth steps on as it hung.
+  EXPECT_EQ(world.pinTargets(cloth).value(), before);
+  const StepStatus status = world.step(kFrameDt);
+  EXPECT_FALSE(hasFlag(status, StepStatus::RolledBack)) << describe(status);
+  EXPECT_LT((world.positions(cloth).value()[0] - positions[0]).norm(), 0.01);
+  // Pins one edge apart may be moved as far as the check allows (99 times the edge's stretch).
+  targets = before;
+  targets[0].x() -= 50 * (before[1] - before[0]).norm();
+  EXPECT_TRUE(world.setPinTargets(cloth, targets).ok());
 }
 
 TEST(PinTeleport, ANegativeOrNonFiniteTeleportDistanceIsRefusedByName) {
