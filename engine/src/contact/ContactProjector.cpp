@@ -104,6 +104,11 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   }
   m_friction.assign(count, Vec3::Zero());
   m_lastOutside.resize(count);
+  // The pairs' masses stay as they are through the sweeps.
+  m_pairMass.assign(count, {0, 0});
+  for (std::size_t c = set.firstPair; c < count; ++c) {
+    m_pairMass[c] = pairInverseMass(set.contacts[c], space.inverseMass);
+  }
   for (int iteration = 0;; ++iteration) {
     const bool backward = iteration % 2 == 1;
     m_frictionOn = iteration < kFrictionSweeps;
@@ -350,7 +355,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
 
 Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact,
                                    Real h) {
-  const auto [inverseMass, weight] = pairInverseMass(contact, space.inverseMass);
+  const auto [inverseMass, weight] = m_pairMass[index];
   if (!(weight > 0)) return 0;
   Vec3 gap = Vec3::Zero();
   for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
@@ -460,7 +465,7 @@ Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,
       }
     } else {
       // A pair in contact keeps no relative velocity into itself.
-      const auto [inverseMass, weight] = pairInverseMass(contact, space.inverseMass);
+      const auto [inverseMass, weight] = m_pairMass[c];
       if (!(weight > 0)) continue;
       Vec3 gap = Vec3::Zero(), relative = Vec3::Zero();
       for (int k = 0; k < 4; ++k) {

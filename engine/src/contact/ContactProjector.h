@@ -56,6 +56,7 @@
 
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace weft {
@@ -109,6 +110,7 @@ class ContactProjector {
   std::vector<Real> m_pushed;     // m, normal displacement the projection gave it
   Vec3Array m_friction;           // m, the friction correction in place
   Vec3Array m_lastOutside;        // vertex contacts: where the vertex last was outside
+  std::vector<std::pair<Real, Real>> m_pairMass;  // pairs: pairInverseMass, fixed in a projection
   bool m_frictionOn = true;       // friction acts in this sweep
   bool m_followTheLeader = true;  // edges move only their end farther from the pins
   std::vector<char> m_visited;    // vertex contacts: path tested from the start already
