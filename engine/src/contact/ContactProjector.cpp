@@ -92,6 +92,16 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   const std::size_t count = set.size();
   m_pushed.assign(count, 0);
   m_visited.assign(count, 0);
+  m_pathFollowed.assign(count, 0);
+  m_contactSeenMoves.assign(count, std::numeric_limits<std::uint64_t>::max());
+  // A vertex on two colliders takes its surface normal from the one visited last: its contacts
+  // are never skipped, so that the normal stays the one a full sweep leaves.
+  m_colliderContactsOf.assign(space.vertexCount(), 0);
+  for (const Contact& contact : set.contacts) {
+    if (contact.kind != ContactKind::VertexCollider) continue;
+    std::uint8_t& contacts = m_colliderContactsOf[contact.vertices[0]];
+    contacts = std::min<std::uint8_t>(contacts + 1, 2);
+  }
   m_moves.assign(space.vertexCount(), 0);
   m_edgeSeenMoves.assign(space.edges.size(), std::numeric_limits<std::uint64_t>::max());
   m_solved = space.x;
@@ -137,6 +147,14 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   for (Index i = 0; i < space.vertexCount(); ++i) space.v[i] += (space.x[i] - m_solved[i]) * inverseStep;
   report.colliderContacts = finish(space, set, colliders, supports);
   return report;
+}
+
+std::uint64_t ContactProjector::movesOf(const Contact& contact) const {
+  std::uint64_t moves = 0;
+  for (Index vertex : contact.vertices) {
+    if (vertex != kInvalidIndex) moves += m_moves[vertex];
+  }
+  return moves;
 }
 
 void ContactProjector::markIfWithin(const ContactSpace& space, Index e) {
@@ -232,6 +250,12 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
   for (std::size_t k = 0; k < count; ++k) {
     const std::size_t c = backward ? count - 1 - k : k;
     const Contact& contact = set.contacts[c];
+    // Its last visit moved nothing, and none of its vertices moved since: a visit now would
+    // compute the same and move nothing again.
+    const std::uint64_t moves = movesOf(contact);
+    if (moves == m_contactSeenMoves[c]) continue;
+    const bool revisit = m_visited[c] != 0;
+    m_visited[c] = 1;
     Real depth = 0;
     switch (contact.kind) {
       case ContactKind::VertexCollider:
@@ -247,6 +271,11 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
     }
     // A contact counts while it still moves its vertices (pushed out, or friction's stick).
     violated += depth > tolerance * space.owners[space.owner[contact.vertices[0]]].thickness;
+    // A vertex contact's first visit follows the vertex's path, later ones do not: only a
+    // later visit that moved nothing repeats itself.
+    const bool sharedNormal = contact.kind == ContactKind::VertexCollider &&
+                              m_colliderContactsOf[contact.vertices[0]] > 1;
+    if (revisit && !sharedNormal && movesOf(contact) == moves) m_contactSeenMoves[c] = moves;
   }
   return violated;
 }
@@ -262,7 +291,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   // Followed from where it was last outside, the body held at its end pose; on the first visit
   // along its whole path relative to the body over the substep, so that a vertex a fast or thin
   // body passed through is found although it ends clear of it.
-  const bool firstVisit = !m_visited[index];
+  const bool firstVisit = !m_pathFollowed[index];
   Vec3 shift = Vec3::Zero();  // the push out, when one is taken
   if (before.distance < thickness || firstVisit) {
     const Vec3 outside =
@@ -274,7 +303,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
       x = outside;
       ++m_moves[i];
     }
-    m_visited[index] = 1;
+    m_pathFollowed[index] = 1;
   }
   m_lastOutside[index] = x;
   const ShapeContact on = shift == Vec3::Zero() ? before : queryPoint(collider.shape, x);

@@ -91,6 +91,8 @@ class ContactProjector {
   // One Gauss–Seidel sweep over the edges over their limit; returns how many were over
   // limit + tolerance before their correction.
   Index sweepEdges(ContactSpace& space, Real tolerance, bool backward);
+  // Σ m_moves over the contact's vertices.
+  std::uint64_t movesOf(const Contact& contact) const;
   // Marks edge e as seen within its limit when it is (sweepEdges skips it until an end moves).
   void markIfWithin(const ContactSpace& space, Index e);
   // One sweep over the contacts; returns how many were violated beyond tolerance.
@@ -113,8 +115,13 @@ class ContactProjector {
   std::vector<std::pair<Real, Real>> m_pairMass;  // pairs: pairInverseMass, fixed in a projection
   bool m_frictionOn = true;       // friction acts in this sweep
   bool m_followTheLeader = true;  // edges move only their end farther from the pins
-  std::vector<char> m_visited;    // vertex contacts: path tested from the start already
+  std::vector<char> m_visited;       // visited in an earlier sweep
+  std::vector<char> m_pathFollowed;  // vertex contacts: path tested from the start already
+  // Per contact: its vertices' m_moves after a visit that moved none of them (sweepContacts
+  // skips it until one moves); max when none.
+  std::vector<std::uint64_t> m_contactSeenMoves;
   std::vector<char> m_touching;   // per vertex: in a contact of the set
+  std::vector<std::uint8_t> m_colliderContactsOf;  // per vertex: its vertex–collider contacts, 2 meaning more
   std::vector<std::uint32_t> m_moves;  // per vertex: how many times the projection moved it
   std::vector<std::uint64_t> m_edgeSeenMoves;  // per edge: its ends' m_moves after its last visit
   Vec3Array m_surfaceNormal;      // per vertex: the collider surface it rests on, zero if none
