@@ -1,5 +1,6 @@
 #include "FoldCulling.h"
 
+#include <weft/collision/Aabb.h>
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
@@ -76,10 +77,15 @@ bool FoldCulling::cannotTouchItself(std::span<const Vec3> start, std::span<const
   if (!m_applicable) return false;
   WEFT_PROFILE_ZONE("fold culling");
   const std::vector<Index>& indices = m_model->indices();
-  // Largest displacement over the step first: it is the cheapest way to fail.
+  // Largest displacement over the step first: it is the cheapest way to fail. Measured from a
+  // common shift c (the middle of the displacements' box): moving every vertex by t·c moves no
+  // feature relative to another, so the argument holds for the displacements less c.
+  Aabb moves = Aabb::empty();
+  for (std::size_t i = 0; i < start.size(); ++i) moves.expand(Vec3(end[i] - start[i]));
+  const Vec3 common = 0.5 * (moves.min + moves.max);
   Real displacement2 = 0;
   for (std::size_t i = 0; i < start.size(); ++i) {
-    displacement2 = std::max(displacement2, (end[i] - start[i]).squaredNorm());
+    displacement2 = std::max(displacement2, (end[i] - start[i] - common).squaredNorm());
   }
   const Real displacement = std::sqrt(displacement2);
   const Real needed = thickness + 2 * displacement;  // δ must exceed this

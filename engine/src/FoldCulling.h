@@ -19,7 +19,9 @@
 //     the closest points of two disjoint features are a vertex of one and the other feature. So
 //     every vertex–triangle and edge–edge pair the pass would test is at least δ apart, in the
 //     plane and so in space.
-//  3. Motion: no vertex moves more than d during the step (3D distance, hence also projected).
+//  3. Motion: no vertex moves more than d during the step (3D distance, hence also projected),
+//     measured from a common shift of the whole cloth (which moves no feature relative to
+//     another: a swinging or falling cloth moves far, its parts little against each other).
 //     Features then approach by at most 2d and no triangle can flip (that needs a relative
 //     motion of a full altitude), so every intermediate position is an embedding with pairs at
 //     least δ − 2d apart.

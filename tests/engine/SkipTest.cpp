@@ -221,11 +221,18 @@ TEST(FoldCulling, AFlatSheetCannotTouchItselfAFoldedOneCan) {
   const Vec3Array& rest = model->restPositions();
   const Real thickness = 0.003;
   EXPECT_TRUE(culling.cannotTouchItself(rest, rest, thickness));
-  // A small motion keeps it clear; a motion of half a spacing may close any gap.
+  // A small motion keeps it clear, and so does any shift of the whole sheet (it moves no part
+  // against another); half the sheet moving a spacing against the other may close a gap.
   Vec3Array moved = rest;
   for (Vec3& x : moved) x.z() += 0.004;
   EXPECT_TRUE(culling.cannotTouchItself(rest, moved, thickness));
-  for (Vec3& x : moved) x.x() += 0.03;
+  for (Vec3& x : moved) x += Vec3(1.0, -0.5, 0.3);
+  EXPECT_TRUE(culling.cannotTouchItself(rest, moved, thickness));
+  moved = rest;
+  const Real middleColumn = rest[columns / 2].x();
+  for (Vec3& x : moved) {
+    if (x.x() > middleColumn) x.x() -= 0.06;
+  }
   EXPECT_FALSE(culling.cannotTouchItself(rest, moved, thickness));
   // Folded in half: the upper half laid 2 mm above the lower one.
   Vec3Array folded = rest;
