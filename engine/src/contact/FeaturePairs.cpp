@@ -4,6 +4,7 @@
 #include <weft/threading/Profiler.h>
 
 #include <algorithm>
+#include <cmath>
 
 namespace weft {
 namespace {
@@ -62,7 +63,20 @@ void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
   }
   m_vertexBoxes.resize(vertexCount);
   m_triangleBoxes.resize(space.triangles.size());
+  m_triangleMotions.resize(space.triangles.size());
   m_edgeBoxes.resize(space.edges.size());
+}
+
+bool FeaturePairs::mayComeWithin(const TriangleMotion& a, const TriangleMotion& b, Real margin) {
+  // Over the step, a point of a lies within a.start moved by t·a.shift and grown by a.spread
+  // (t in [0, 1]): the gap along each axis shrinks by at most the shifts' difference there and
+  // both spreads.
+  const Real spread = a.spread + b.spread;
+  for (int k = 0; k < 3; ++k) {
+    const Real gap = std::max(b.start.min[k] - a.start.max[k], a.start.min[k] - b.start.max[k]);
+    if (gap - std::abs(b.shift[k] - a.shift[k]) - spread > margin) return false;
+  }
+  return true;
 }
 
 void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
@@ -139,6 +153,14 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
         box.expand(m_vertexBoxes[c[1]]);
         box.expand(m_vertexBoxes[c[2]]);
         m_triangleBoxes[i] = box;
+        // The triangle's motion as a common shift and each corner's spread around it.
+        TriangleMotion& motion = m_triangleMotions[i];
+        motion.start = Aabb::fromCorners(from[c[0]], from[c[1]]);
+        motion.start.expand(from[c[2]]);
+        const Vec3 moves[3] = {to[c[0]] - from[c[0]], to[c[1]] - from[c[1]], to[c[2]] - from[c[2]]};
+        motion.shift = (moves[0] + moves[1] + moves[2]) / 3;
+        motion.spread = std::max({(moves[0] - motion.shift).norm(), (moves[1] - motion.shift).norm(),
+                                  (moves[2] - motion.shift).norm()});
       } else {
         const auto& c = edges[i - triangleCount];
         Aabb box = m_vertexBoxes[c[0]];
@@ -182,6 +204,7 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
                           std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
       const TrianglePair& pair = m_trianglePairs[k];
+      if (!mayComeWithin(m_triangleMotions[pair.first], m_triangleMotions[pair.second], margin)) continue;
       const Aabb& firstBox = m_triangleBoxes[pair.first];
       const Aabb& secondBox = m_triangleBoxes[pair.second];
       // Every feature box of a triangle lies in its box: when the inflated triangle box misses

@@ -80,6 +80,18 @@ class FeaturePairs {
   std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
   std::vector<std::array<Index, 2>> m_edgeTriangles;  // the triangles of each edge
   std::vector<Aabb> m_vertexBoxes, m_triangleBoxes, m_edgeBoxes;
+  // A triangle's motion over the step: its start box, the mean of its corners' moves, and the
+  // largest distance of a corner's move from that mean.
+  struct TriangleMotion {
+    Aabb start;
+    Vec3 shift;
+    Real spread;
+  };
+  std::vector<TriangleMotion> m_triangleMotions;
+  // Whether two triangles moving as `a` and `b` may come within `margin` of each other along
+  // every axis at some time of the step: pairs moving together are dismissed however far
+  // they travel, where their swept boxes would overlap.
+  static bool mayComeWithin(const TriangleMotion& a, const TriangleMotion& b, Real margin);
   struct BlockFeatures {
     std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
   };
