@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace weft {
 namespace {
@@ -67,16 +68,27 @@ void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
   m_edgeBoxes.resize(space.edges.size());
 }
 
-bool FeaturePairs::mayComeWithin(const TriangleMotion& a, const TriangleMotion& b, Real margin) {
-  // Over the step, a point of a lies within a.start moved by t·a.shift and grown by a.spread
-  // (t in [0, 1]): the gap along each axis shrinks by at most the shifts' difference there and
-  // both spreads.
+bool FeaturePairs::mayComeWithin(const TriangleMotion& a, const TriangleMotion& b,
+                                 std::span<const Vec3> ca, std::span<const Vec3> cb, Real margin) {
+  // Over the step, a point of a lies within its start shape moved by t·a.shift and grown by
+  // a.spread (t in [0, 1]): the gap along any direction shrinks by at most the shifts'
+  // difference along it and both spreads.
   const Real spread = a.spread + b.spread;
   for (int k = 0; k < 3; ++k) {
     const Real gap = std::max(b.start.min[k] - a.start.max[k], a.start.min[k] - b.start.max[k]);
     if (gap - std::abs(b.shift[k] - a.shift[k]) - spread > margin) return false;
   }
-  return true;
+  // Along the line between the centroids, which parts triangles of a grid whose boxes overlap
+  // (neighbours across a diagonal). Pairs within the margin along every axis are within √3 of
+  // it in distance, so that is the margin here.
+  Vec3 axis = b.centroid - a.centroid;
+  const Real length = axis.norm();
+  if (!(length > 0)) return true;
+  axis /= length;
+  const Real endOfA = std::max({ca[0].dot(axis), ca[1].dot(axis), ca[2].dot(axis)});
+  const Real startOfB = std::min({cb[0].dot(axis), cb[1].dot(axis), cb[2].dot(axis)});
+  const Real approach = std::abs((b.shift - a.shift).dot(axis)) + spread;
+  return !(startOfB - endOfA - approach > std::numbers::sqrt3 * margin);
 }
 
 void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
@@ -157,6 +169,7 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
         TriangleMotion& motion = m_triangleMotions[i];
         motion.start = Aabb::fromCorners(from[c[0]], from[c[1]]);
         motion.start.expand(from[c[2]]);
+        motion.centroid = (from[c[0]] + from[c[1]] + from[c[2]]) / 3;
         const Vec3 moves[3] = {to[c[0]] - from[c[0]], to[c[1]] - from[c[1]], to[c[2]] - from[c[2]]};
         motion.shift = (moves[0] + moves[1] + moves[2]) / 3;
         motion.spread = std::max({(moves[0] - motion.shift).norm(), (moves[1] - motion.shift).norm(),
@@ -204,7 +217,14 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
                           std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
       const TrianglePair& pair = m_trianglePairs[k];
-      if (!mayComeWithin(m_triangleMotions[pair.first], m_triangleMotions[pair.second], margin)) continue;
+      const auto& first = triangles[pair.first];
+      const auto& second = triangles[pair.second];
+      const std::array<Vec3, 3> firstStart{from[first[0]], from[first[1]], from[first[2]]};
+      const std::array<Vec3, 3> secondStart{from[second[0]], from[second[1]], from[second[2]]};
+      if (!mayComeWithin(m_triangleMotions[pair.first], m_triangleMotions[pair.second], firstStart,
+                         secondStart, margin)) {
+        continue;
+      }
       const Aabb& firstBox = m_triangleBoxes[pair.first];
       const Aabb& secondBox = m_triangleBoxes[pair.second];
       // Every feature box of a triangle lies in its box: when the inflated triangle box misses

@@ -19,6 +19,7 @@
 
 #include <initializer_list>
 #include <memory>
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -84,14 +85,16 @@ class FeaturePairs {
   // largest distance of a corner's move from that mean.
   struct TriangleMotion {
     Aabb start;
+    Vec3 centroid;  // at the start
     Vec3 shift;
     Real spread;
   };
   std::vector<TriangleMotion> m_triangleMotions;
-  // Whether two triangles moving as `a` and `b` may come within `margin` of each other along
-  // every axis at some time of the step: pairs moving together are dismissed however far
-  // they travel, where their swept boxes would overlap.
-  static bool mayComeWithin(const TriangleMotion& a, const TriangleMotion& b, Real margin);
+  // Whether two triangles moving as `a` and `b`, with start corners `ca` and `cb`, may come
+  // within `margin` of each other along every axis at some time of the step: pairs moving
+  // together are dismissed however far they travel, where their swept boxes would overlap.
+  static bool mayComeWithin(const TriangleMotion& a, const TriangleMotion& b,
+                            std::span<const Vec3> ca, std::span<const Vec3> cb, Real margin);
   struct BlockFeatures {
     std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
   };
