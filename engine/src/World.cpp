@@ -194,10 +194,10 @@ World::World(const WorldSettings& settings)
 }
 
 std::uint64_t World::estimatedClothBytes(std::uint64_t vertices, std::uint64_t triangles) {
-  // Measured peaks (bench/results/memory-footprint.md): 5.9-6.2 kB a vertex for createCloth()
+  // Measured peaks (bench/results/memory-footprint.md): 7.0-8.2 kB a vertex for createCloth()
   // and the first frames of a hanging cloth of 2 triangles a vertex; a third more for buffers
   // that grow in steps and for contacts.
-  constexpr std::uint64_t kBytesPerVertex = 4096, kBytesPerTriangle = 2048;
+  constexpr std::uint64_t kBytesPerVertex = 6144, kBytesPerTriangle = 2560;
   return kBytesPerVertex * vertices + kBytesPerTriangle * triangles;
 }
 

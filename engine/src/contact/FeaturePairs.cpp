@@ -75,7 +75,8 @@ bool FeaturePairs::mayComeWithin(const TriangleMotion& a, const TriangleMotion& 
   // difference along it and both spreads.
   const Real spread = a.spread + b.spread;
   for (int k = 0; k < 3; ++k) {
-    const Real gap = std::max(b.start.min[k] - a.start.max[k], a.start.min[k] - b.start.max[k]);
+    const Real gap = std::max(std::min({cb[0][k], cb[1][k], cb[2][k]}) - std::max({ca[0][k], ca[1][k], ca[2][k]}),
+                              std::min({ca[0][k], ca[1][k], ca[2][k]}) - std::max({cb[0][k], cb[1][k], cb[2][k]}));
     if (gap - std::abs(b.shift[k] - a.shift[k]) - spread > margin) return false;
   }
   // Along the line between the centroids, which parts triangles of a grid whose boxes overlap
@@ -167,8 +168,6 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
         m_triangleBoxes[i] = box;
         // The triangle's motion as a common shift and each corner's spread around it.
         TriangleMotion& motion = m_triangleMotions[i];
-        motion.start = Aabb::fromCorners(from[c[0]], from[c[1]]);
-        motion.start.expand(from[c[2]]);
         motion.centroid = (from[c[0]] + from[c[1]] + from[c[2]]) / 3;
         const Vec3 moves[3] = {to[c[0]] - from[c[0]], to[c[1]] - from[c[1]], to[c[2]] - from[c[2]]};
         motion.shift = (moves[0] + moves[1] + moves[2]) / 3;

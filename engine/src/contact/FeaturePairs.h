@@ -81,11 +81,10 @@ class FeaturePairs {
   std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
   std::vector<std::array<Index, 2>> m_edgeTriangles;  // the triangles of each edge
   std::vector<Aabb> m_vertexBoxes, m_triangleBoxes, m_edgeBoxes;
-  // A triangle's motion over the step: its start box, the mean of its corners' moves, and the
-  // largest distance of a corner's move from that mean.
+  // A triangle's motion over the step: its start centroid, the mean of its corners' moves, and
+  // the largest distance of a corner's move from that mean.
   struct TriangleMotion {
-    Aabb start;
-    Vec3 centroid;  // at the start
+    Vec3 centroid;
     Vec3 shift;
     Real spread;
   };
