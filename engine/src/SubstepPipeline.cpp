@@ -189,8 +189,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     if (failure == HealthFailure::None && substeps * 2 <= strainRetryCap &&
         strainRetryHelps(cloths)) {
       for (std::size_t c = 0; c < cloths.size(); ++c) {
-        if (!m_stepping[c]) continue;
-        cloths[c]->restoreFrameStart();
+        if (m_stepping[c]) cloths[c]->restoreFrameStart();
       }
       ++stats.strainRetries;
       substeps *= 2;
@@ -242,7 +241,8 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
                                        : m_endStrain[c];
     reportStrain(cloth, strain, stats);
     if (m_stepping[c]) {
-      m_strainRetriesFailed[c] = pastLimit(cloth, strain) && (stats.strainRetries > 0 || m_strainRetriesFailed[c]);
+      m_strainRetriesFailed[c] =
+          pastLimit(cloth, strain) && (stats.strainRetries > 0 || m_strainRetriesFailed[c]);
     }
     stats.kineticEnergy += cloth.kineticEnergy();
     stats.maxSpeed = std::max(stats.maxSpeed, cloth.maxSpeed());

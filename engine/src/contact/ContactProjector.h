@@ -22,7 +22,8 @@
 //    on the next sweep and converge at m_light / m_heavy per iteration).
 // An edge left within its limit whose ends have not moved since (each vertex counts its moves)
 // is skipped, which changes nothing (its correction would be none): the late sweeps, where a few
-// edges are still converging, measure only the edges near them.
+// edges are still converging, measure only the edges near them. A contact whose last visit moved
+// none of its vertices is skipped alike until one of them moves.
 // Every position change Δx is made as the velocity change Δx / h too, so v stays the substep's
 // average velocity. Sweeps alternate direction; the iteration stops when no edge is over its
 // limit by more than the tolerance and no contact is violated by more than its tolerance.

@@ -68,26 +68,37 @@ void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
   m_edgeBoxes.resize(space.edges.size());
 }
 
-bool FeaturePairs::mayComeWithin(const TriangleMotion& a, const TriangleMotion& b,
-                                 std::span<const Vec3> ca, std::span<const Vec3> cb, Real margin) {
+TriangleMotion triangleMotion(std::span<const Vec3, 3> start, std::span<const Vec3, 3> end) {
+  TriangleMotion motion;
+  motion.centroid = (start[0] + start[1] + start[2]) / 3;
+  const Vec3 moves[3] = {end[0] - start[0], end[1] - start[1], end[2] - start[2]};
+  motion.shift = (moves[0] + moves[1] + moves[2]) / 3;
+  motion.spread = std::max({(moves[0] - motion.shift).norm(), (moves[1] - motion.shift).norm(),
+                            (moves[2] - motion.shift).norm()});
+  return motion;
+}
+
+bool trianglesMayComeWithin(const TriangleMotion& a, std::span<const Vec3, 3> startA,
+                            const TriangleMotion& b, std::span<const Vec3, 3> startB, Real margin) {
   // Over the step, a point of a lies within its start shape moved by t·a.shift and grown by
   // a.spread (t in [0, 1]): the gap along any direction shrinks by at most the shifts'
   // difference along it and both spreads.
+  const auto low = [](std::span<const Vec3, 3> c, int k) { return std::min({c[0][k], c[1][k], c[2][k]}); };
+  const auto high = [](std::span<const Vec3, 3> c, int k) { return std::max({c[0][k], c[1][k], c[2][k]}); };
   const Real spread = a.spread + b.spread;
   for (int k = 0; k < 3; ++k) {
-    const Real gap = std::max(std::min({cb[0][k], cb[1][k], cb[2][k]}) - std::max({ca[0][k], ca[1][k], ca[2][k]}),
-                              std::min({ca[0][k], ca[1][k], ca[2][k]}) - std::max({cb[0][k], cb[1][k], cb[2][k]}));
+    const Real gap = std::max(low(startB, k) - high(startA, k), low(startA, k) - high(startB, k));
     if (gap - std::abs(b.shift[k] - a.shift[k]) - spread > margin) return false;
   }
   // Along the line between the centroids, which parts triangles of a grid whose boxes overlap
-  // (neighbours across a diagonal). Pairs within the margin along every axis are within √3 of
-  // it in distance, so that is the margin here.
+  // (neighbours across a diagonal). Pairs within the margin along every axis are within √3 times
+  // the margin of each other, so that is the margin along this line.
   Vec3 axis = b.centroid - a.centroid;
   const Real length = axis.norm();
   if (!(length > 0)) return true;
   axis /= length;
-  const Real endOfA = std::max({ca[0].dot(axis), ca[1].dot(axis), ca[2].dot(axis)});
-  const Real startOfB = std::min({cb[0].dot(axis), cb[1].dot(axis), cb[2].dot(axis)});
+  const Real endOfA = std::max({startA[0].dot(axis), startA[1].dot(axis), startA[2].dot(axis)});
+  const Real startOfB = std::min({startB[0].dot(axis), startB[1].dot(axis), startB[2].dot(axis)});
   const Real approach = std::abs((b.shift - a.shift).dot(axis)) + spread;
   return !(startOfB - endOfA - approach > std::numbers::sqrt3 * margin);
 }
@@ -166,13 +177,9 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
         box.expand(m_vertexBoxes[c[1]]);
         box.expand(m_vertexBoxes[c[2]]);
         m_triangleBoxes[i] = box;
-        // The triangle's motion as a common shift and each corner's spread around it.
-        TriangleMotion& motion = m_triangleMotions[i];
-        motion.centroid = (from[c[0]] + from[c[1]] + from[c[2]]) / 3;
-        const Vec3 moves[3] = {to[c[0]] - from[c[0]], to[c[1]] - from[c[1]], to[c[2]] - from[c[2]]};
-        motion.shift = (moves[0] + moves[1] + moves[2]) / 3;
-        motion.spread = std::max({(moves[0] - motion.shift).norm(), (moves[1] - motion.shift).norm(),
-                                  (moves[2] - motion.shift).norm()});
+        const std::array<Vec3, 3> start{from[c[0]], from[c[1]], from[c[2]]};
+        const std::array<Vec3, 3> end{to[c[0]], to[c[1]], to[c[2]]};
+        m_triangleMotions[i] = triangleMotion(start, end);
       } else {
         const auto& c = edges[i - triangleCount];
         Aabb box = m_vertexBoxes[c[0]];
@@ -220,8 +227,8 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
       const auto& second = triangles[pair.second];
       const std::array<Vec3, 3> firstStart{from[first[0]], from[first[1]], from[first[2]]};
       const std::array<Vec3, 3> secondStart{from[second[0]], from[second[1]], from[second[2]]};
-      if (!mayComeWithin(m_triangleMotions[pair.first], m_triangleMotions[pair.second], firstStart,
-                         secondStart, margin)) {
+      if (!trianglesMayComeWithin(m_triangleMotions[pair.first], firstStart,
+                                  m_triangleMotions[pair.second], secondStart, margin)) {
         continue;
       }
       const Aabb& firstBox = m_triangleBoxes[pair.first];

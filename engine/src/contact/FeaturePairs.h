@@ -17,6 +17,7 @@
 #include <weft/threading/PerWorker.h>
 #include <weft/threading/TaskSystem.h>
 
+#include <array>
 #include <initializer_list>
 #include <memory>
 #include <span>
@@ -37,6 +38,25 @@ inline bool featureBoxesWithin(std::initializer_list<Index> first,
   a.inflate(reach);
   return a.overlaps(b);
 }
+
+/// A triangle's motion over a step on straight lines: where its corners start, their mean move
+/// and how far a corner's move is from that mean.
+struct TriangleMotion {
+  Vec3 centroid;  ///< m, of the start corners
+  Vec3 shift;     ///< m, the mean of the corners' moves
+  Real spread;    ///< m, the largest distance of a corner's move from the mean
+};
+
+/// The motion of the triangle whose corners move from `start` to `end`.
+TriangleMotion triangleMotion(std::span<const Vec3, 3> start, std::span<const Vec3, 3> end);
+
+/// Whether two triangles, starting at corners `startA` and `startB` and moving as `a` and `b`,
+/// may come within `margin` (m) of each other along every axis at some time of the step. False
+/// is a proof that they do not, by their gap along each axis and along the line between their
+/// centroids: pairs moving together are dismissed however far they travel, where the boxes of
+/// their paths would overlap.
+bool trianglesMayComeWithin(const TriangleMotion& a, std::span<const Vec3, 3> startA,
+                            const TriangleMotion& b, std::span<const Vec3, 3> startB, Real margin);
 
 class FeaturePairs {
  public:
@@ -81,19 +101,7 @@ class FeaturePairs {
   std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
   std::vector<std::array<Index, 2>> m_edgeTriangles;  // the triangles of each edge
   std::vector<Aabb> m_vertexBoxes, m_triangleBoxes, m_edgeBoxes;
-  // A triangle's motion over the step: its start centroid, the mean of its corners' moves, and
-  // the largest distance of a corner's move from that mean.
-  struct TriangleMotion {
-    Vec3 centroid;
-    Vec3 shift;
-    Real spread;
-  };
-  std::vector<TriangleMotion> m_triangleMotions;
-  // Whether two triangles moving as `a` and `b`, with start corners `ca` and `cb`, may come
-  // within `margin` of each other along every axis at some time of the step: pairs moving
-  // together are dismissed however far they travel, where their swept boxes would overlap.
-  static bool mayComeWithin(const TriangleMotion& a, const TriangleMotion& b,
-                            std::span<const Vec3> ca, std::span<const Vec3> cb, Real margin);
+  std::vector<TriangleMotion> m_triangleMotions;  // per triangle, over the step of collect()
   struct BlockFeatures {
     std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
   };
