@@ -92,7 +92,6 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   const std::size_t count = set.size();
   m_pushed.assign(count, 0);
   m_visited.assign(count, 0);
-  m_pathFollowed.assign(count, 0);
   m_contactSeenMoves.assign(count, std::numeric_limits<std::uint64_t>::max());
   // A vertex on two colliders takes its surface normal from the one visited last: its contacts
   // are never skipped, so that the normal stays the one a full sweep leaves.
@@ -255,7 +254,6 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
     const std::uint64_t moves = movesOf(contact);
     if (moves == m_contactSeenMoves[c]) continue;
     const bool revisit = m_visited[c] != 0;
-    m_visited[c] = 1;
     Real depth = 0;
     switch (contact.kind) {
       case ContactKind::VertexCollider:
@@ -276,6 +274,7 @@ Index ContactProjector::sweepContacts(ContactSpace& space, const ContactSet& set
     const bool sharedNormal = contact.kind == ContactKind::VertexCollider &&
                               m_colliderContactsOf[contact.vertices[0]] > 1;
     if (revisit && !sharedNormal && movesOf(contact) == moves) m_contactSeenMoves[c] = moves;
+    m_visited[c] = 1;
   }
   return violated;
 }
@@ -291,7 +290,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   // Followed from where it was last outside, the body held at its end pose; on the first visit
   // along its whole path relative to the body over the substep, so that a vertex a fast or thin
   // body passed through is found although it ends clear of it.
-  const bool firstVisit = !m_pathFollowed[index];
+  const bool firstVisit = !m_visited[index];
   Vec3 shift = Vec3::Zero();  // the push out, when one is taken
   if (before.distance < thickness || firstVisit) {
     const Vec3 outside =
@@ -303,7 +302,6 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
       x = outside;
       ++m_moves[i];
     }
-    m_pathFollowed[index] = 1;
   }
   m_lastOutside[index] = x;
   const ShapeContact on = shift == Vec3::Zero() ? before : queryPoint(collider.shape, x);

@@ -116,8 +116,7 @@ class ContactProjector {
   std::vector<std::pair<Real, Real>> m_pairMass;  // pairs: pairInverseMass, fixed in a projection
   bool m_frictionOn = true;       // friction acts in this sweep
   bool m_followTheLeader = true;  // edges move only their end farther from the pins
-  std::vector<char> m_visited;       // visited in an earlier sweep
-  std::vector<char> m_pathFollowed;  // vertex contacts: path tested from the start already
+  std::vector<char> m_visited;    // visited in an earlier sweep (a vertex contact's path tested)
   // Per contact: its vertices' m_moves after a visit that moved none of them (sweepContacts
   // skips it until one moves); max when none.
   std::vector<std::uint64_t> m_contactSeenMoves;

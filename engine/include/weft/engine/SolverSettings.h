@@ -63,9 +63,9 @@ struct SolverSettings {
   /// Mean rest edge lengths a pin may travel in one automatic substep; more substeps when pins
   /// move faster. Raising it saves substeps at the cost of strain in those frames. 0 = no limit.
   Real maxPinTravelPerSubstep = 1;
-  /// Automatic substeps: a frame that leaves a cloth past its strain limit + kStrainLimitSlack,
-  /// strained more than at its start, is redone with twice the substeps while each redo lowers the
-  /// strain, within this many substeps (a squeeze through a ring at 60 Hz needs 4–8). 0 = never. Default 8.
+  /// Automatic substeps: a frame that leaves a cloth past its strain limit + kStrainLimitSlack is
+  /// redone with twice the substeps within this many (a squeeze through a ring at 60 Hz needs 4–8),
+  /// except while redos already failed to bring the cloth back within its limit. 0 = never. Default 8.
   Index strainRetrySubsteps = 8;
   /// Cloth sizes (ClothModel::characteristicLength) every pin must move in one frame for the frame
   /// to be a teleport: the cloth is carried by the pins' best-fit rigid motion instead of dragged
