@@ -107,14 +107,7 @@ void Cloth::buildSystemRows() {
   const bool remove = m_settings.solver.removePinnedVertices &&
                       m_settings.solver.integrator == IntegratorKind::ImplicitEuler;
   m_freeVertexMap.build(n, remove ? std::span<const Index>(m_pinnedSorted) : std::span<const Index>());
-  const std::vector<std::array<Index, 2>> pairs = m_forces.coupledPairs();
-  std::vector<std::array<Index, 2>> rowPairs;
-  rowPairs.reserve(pairs.size());
-  for (const auto& [a, b] : pairs) {
-    const Index rowA = m_freeVertexMap.row(a), rowB = m_freeVertexMap.row(b);
-    if (rowA != kInvalidIndex && rowB != kInvalidIndex) rowPairs.push_back({rowA, rowB});
-  }
-  m_matrix.build(m_freeVertexMap.rowCount(), rowPairs);
+  m_forces.buildSystem(m_freeVertexMap, m_matrix, m_pinnedCoupling);
   if (m_vertexColors.size() != n) {
     m_vertexColors = MulticolorOrdering::colorVertices(n, m_forces.potentialCoupledPairs());
   }
@@ -122,8 +115,6 @@ void Cloth::buildSystemRows() {
   for (Index row = 0; row < m_freeVertexMap.rowCount(); ++row) {
     m_rowColors[row] = m_vertexColors[m_freeVertexMap.vertex(row)];
   }
-  m_pinnedCoupling.build(m_freeVertexMap, pairs);
-  m_forces.bindMatrix(m_matrix, m_freeVertexMap, m_pinnedCoupling);
   m_contactRows.clear();
   m_contactRows.reserve(m_freeVertexMap.rowCount());
 }

@@ -229,6 +229,49 @@ std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
   return pairs;
 }
 
+std::vector<std::array<Index, 2>> ClothForces::isotropicPairs() const {
+  if (!m_isometricBending) return {};
+  // Pairs some element holds write full blocks; sorted (smaller, larger) for the lookup.
+  std::vector<std::array<Index, 2>> general;
+  const auto addAll = [&general](std::span<const Index> vertices) {
+    appendAllPairs(vertices, general);
+  };
+  for (const auto& element : m_triangles) addAll(element.vertices);
+  for (const auto& element : m_hinges) addAll(element.vertices);
+  for (const auto& element : m_springs) addAll(element.vertices);
+  for (auto& pair : general) {
+    if (pair[0] > pair[1]) std::swap(pair[0], pair[1]);
+  }
+  std::sort(general.begin(), general.end());
+  std::vector<std::array<Index, 2>> pairs;
+  for (Index row = 0; row + 1 < Index(m_bendingRowOffsets.size()); ++row) {
+    for (Index k = m_bendingRowOffsets[row]; k < m_bendingRowOffsets[row + 1]; ++k) {
+      const std::array<Index, 2> pair{row, m_bendingEntries[k].column};
+      if (pair[1] > row && !std::binary_search(general.begin(), general.end(), pair)) {
+        pairs.push_back(pair);
+      }
+    }
+  }
+  return pairs;
+}
+
+void ClothForces::buildSystem(const FreeVertexMap& map, BlockSparseMatrix& matrix,
+                              PinnedCoupling& coupling) {
+  const auto toRows = [&map](const std::vector<std::array<Index, 2>>& pairs) {
+    std::vector<std::array<Index, 2>> rowPairs;
+    rowPairs.reserve(pairs.size());
+    for (const auto& [a, b] : pairs) {
+      const Index rowA = map.row(a), rowB = map.row(b);
+      if (rowA != kInvalidIndex && rowB != kInvalidIndex) rowPairs.push_back({rowA, rowB});
+    }
+    return rowPairs;
+  };
+  const std::vector<std::array<Index, 2>> pairs = coupledPairs();
+  matrix.build(map.rowCount(), toRows(pairs), toRows(isotropicPairs()));
+  coupling.build(map, pairs);
+  bindMatrix(matrix, map, coupling);
+}
+
 std::vector<std::array<Index, 2>> ClothForces::potentialCoupledPairs() const {
   std::vector<std::array<Index, 2>> pairs;
   const auto addAll = [&pairs](std::span<const Index> vertices) { appendAllPairs(vertices, pairs); };

@@ -72,6 +72,13 @@ class ClothForces {
 
   /// Vertex pairs that some element couples: the sparsity pattern of the system matrix.
   std::vector<std::array<Index, 2>> coupledPairs() const;
+  /// The pairs of coupledPairs() that only isometric bending couples: their blocks are
+  /// (h k_d + h² D) K̂_ij I₃, multiples of the identity (BlockSparseMatrix::isotropic()).
+  std::vector<std::array<Index, 2>> isotropicPairs() const;
+  /// Builds the system of `map`'s rows: `matrix` with the pattern of coupledPairs() between rows
+  /// (isotropicPairs() marked), `coupling` with the blocks towards removed vertices, and binds
+  /// them (bindMatrix). Allocates; call at set-up and when the map changes.
+  void buildSystem(const FreeVertexMap& map, BlockSparseMatrix& matrix, PinnedCoupling& coupling);
   /// Vertex pairs that some force term of this model could couple whatever its coefficients
   /// (also terms left out because they are zero, ClothForceSettings::skipZeroTerms): a superset
   /// of coupledPairs() fixed by the mesh and the force and bending models, for the solver's

@@ -17,6 +17,7 @@
 
 #include <Eigen/Dense>
 
+#include <algorithm>
 #include <array>
 #include <random>
 #include <vector>
@@ -32,8 +33,11 @@ Vec3 randomVec3(std::mt19937& random) {
 }
 
 /// A grid-patterned SPD system (mass + spring-like element stiffnesses with non-symmetric
-/// off-diagonal blocks) plus a few long-range pairs, like FilteredPcgTest's.
-BlockSparseMatrix randomSystem(Index vertexCount, unsigned seed, Real stiffness) {
+/// off-diagonal blocks) plus a few long-range pairs, like FilteredPcgTest's. With `isotropic`,
+/// also pairs two apart along the rows whose blocks are multiples of the identity (a scalar
+/// Laplacian ⊗ I₃, as isometric bending's), marked as such.
+BlockSparseMatrix randomSystem(Index vertexCount, unsigned seed, Real stiffness,
+                               bool isotropic = false) {
   std::mt19937 random(seed);
   constexpr Index kWidth = 20;
   std::vector<Pair> pairs;
@@ -49,8 +53,26 @@ BlockSparseMatrix randomSystem(Index vertexCount, unsigned seed, Real stiffness)
     const Index i = pick(random), j = pick(random);
     if (i != j) pairs.push_back({i, j});
   }
-  BlockSparseMatrix A(vertexCount, pairs);
+  std::vector<Pair> isotropicPairs;
+  if (isotropic) {
+    for (Index v = 0; v + 2 < vertexCount; ++v) {
+      const bool general = std::any_of(pairs.begin(), pairs.end(), [v](const Pair& pair) {
+        return std::min(pair[0], pair[1]) == v && std::max(pair[0], pair[1]) == v + 2;
+      });
+      if (v % kWidth < kWidth - 2 && !general) isotropicPairs.push_back({v, v + 2});
+    }
+  }
+  std::vector<Pair> all = pairs;
+  all.insert(all.end(), isotropicPairs.begin(), isotropicPairs.end());
+  BlockSparseMatrix A(vertexCount, all, isotropicPairs);
   for (Index i = 0; i < vertexCount; ++i) A.block(A.diagonalSlot(i)) += Mat3::Identity();
+  for (const auto& [i, j] : isotropicPairs) {
+    const Real weight = stiffness * std::uniform_real_distribution<Real>(0.05, 0.5)(random);
+    A.block(A.slot(i, i)) += weight * Mat3::Identity();
+    A.block(A.slot(j, j)) += weight * Mat3::Identity();
+    A.block(A.slot(i, j)) -= weight * Mat3::Identity();
+    A.block(A.slot(j, i)) -= weight * Mat3::Identity();
+  }
   for (const Pair& pair : pairs) {
     const Vec3 axis = randomVec3(random);
     const Mat3 spring = stiffness * (axis * axis.transpose() + 0.1 * Mat3::Identity());
@@ -96,7 +118,7 @@ Real dot(const Vec3Array& a, const Vec3Array& b) {
 // ------------------------------------------------------------------------- MulticolorOrdering
 
 TEST(MulticolorOrdering, ColoursSeparateCoupledVerticesAndSplitEveryOffDiagonalSlot) {
-  const BlockSparseMatrix A = randomSystem(500, 1, 10);
+  const BlockSparseMatrix A = randomSystem(500, 1, 10, /*isotropic=*/true);
   MulticolorOrdering ordering;
   EXPECT_FALSE(ordering.matches(A));
   ordering.build(A);
@@ -128,22 +150,32 @@ TEST(MulticolorOrdering, ColoursSeparateCoupledVerticesAndSplitEveryOffDiagonalS
       ++offDiagonal;
       ASSERT_NE(ordering.color(A.column(s)), ordering.color(row)) << "coupled pair shares a colour";
     }
-    const Index lowerCount = ordering.lowerBegin(k + 1) - ordering.lowerBegin(k);
-    const Index upperCount = ordering.upperBegin(k + 1) - ordering.upperBegin(k);
-    EXPECT_EQ(lowerCount + upperCount, offDiagonal) << "row " << row;
-    for (Index e = ordering.lowerBegin(k); e < ordering.lowerBegin(k + 1); ++e) {
-      const Index slot = ordering.lowerSlots()[e];
-      EXPECT_EQ(A.column(slot), ordering.lowerColumns()[e]);
-      EXPECT_GE(slot, A.rowBegin(row));
-      EXPECT_LT(slot, A.rowEnd(row));
-      EXPECT_LT(ordering.color(A.column(slot)), ordering.color(row));
+    // Every entry names a slot of this row, on the right side of the colour order, in the list
+    // of its kind (isotropic or general).
+    Index entries = 0, isotropicEntries = 0;
+    for (const bool lower : {true, false}) {
+      const SweepTriangle& triangle = lower ? ordering.lower() : ordering.upper();
+      for (const bool isotropic : {false, true}) {
+        const SweepEntries& list = isotropic ? triangle.isotropic : triangle.general;
+        for (Index e = list.begin(k); e < list.begin(k + 1); ++e) {
+          const Index slot = list.slots[e];
+          ++entries;
+          EXPECT_EQ(A.column(slot), list.columns[e]);
+          EXPECT_GE(slot, A.rowBegin(row));
+          EXPECT_LT(slot, A.rowEnd(row));
+          EXPECT_EQ(A.isotropic(slot), isotropic) << "row " << row << " slot " << slot;
+          if (isotropic) ++isotropicEntries;
+          if (lower) {
+            EXPECT_LT(ordering.color(A.column(slot)), ordering.color(row));
+          } else {
+            EXPECT_GT(ordering.color(A.column(slot)), ordering.color(row));
+          }
+        }
+      }
     }
-    for (Index e = ordering.upperBegin(k); e < ordering.upperBegin(k + 1); ++e) {
-      const Index slot = ordering.upperSlots()[e];
-      EXPECT_EQ(A.column(slot), ordering.upperColumns()[e]);
-      EXPECT_GE(slot, A.rowBegin(row));
-      EXPECT_LT(slot, A.rowEnd(row));
-      EXPECT_GT(ordering.color(A.column(slot)), ordering.color(row));
+    EXPECT_EQ(entries, offDiagonal) << "row " << row;
+    if (row % 20 < 18 && row + 2 < 500) {
+      EXPECT_GE(isotropicEntries, 1u) << "row " << row;
     }
   }
 
@@ -209,9 +241,13 @@ TEST(MulticolorOrdering, GivenColoursOfASupergraphOrderTheRowsAndBadOnesFallBack
   // Every off-diagonal slot of the pattern is split, none within a colour.
   for (Index k = 0; k < n; ++k) {
     const Index row = ordering.order()[k];
-    EXPECT_EQ(ordering.lowerBegin(k + 1) - ordering.lowerBegin(k) + ordering.upperBegin(k + 1) -
-                  ordering.upperBegin(k),
-              A.rowEnd(row) - A.rowBegin(row) - 1);
+    Index entries = 0;
+    for (const SweepTriangle* triangle : {&ordering.lower(), &ordering.upper()}) {
+      for (const SweepEntries* list : {&triangle->general, &triangle->isotropic}) {
+        entries += list->begin(k + 1) - list->begin(k);
+      }
+    }
+    EXPECT_EQ(entries, A.rowEnd(row) - A.rowBegin(row) - 1);
   }
 
   // Colours that put a coupled pair together, or of the wrong length, are not used: the pattern
@@ -230,7 +266,8 @@ TEST(MulticolorOrdering, GivenColoursOfASupergraphOrderTheRowsAndBadOnesFallBack
 
 TEST(GaussSeidelPreconditioner, MatchesTheDenseSymmetricGaussSeidelOfTheFilteredMatrix) {
   constexpr Index n = 120;
-  const BlockSparseMatrix A = randomSystem(n, 2, 30);
+  // Isotropic blocks too: the sweeps multiply them as scalars.
+  const BlockSparseMatrix A = randomSystem(n, 2, 30, /*isotropic=*/true);
   std::mt19937 random(22);
   const VertexFilter filter = mixedFilter(n, random);
   MulticolorOrdering ordering;

@@ -8,12 +8,14 @@
 namespace weft {
 
 BlockSparseMatrix::BlockSparseMatrix(Index blockRows,
-                                     std::span<const std::array<Index, 2>> coupledPairs) {
-  build(blockRows, coupledPairs);
+                                     std::span<const std::array<Index, 2>> coupledPairs,
+                                     std::span<const std::array<Index, 2>> isotropicPairs) {
+  build(blockRows, coupledPairs, isotropicPairs);
 }
 
 void BlockSparseMatrix::build(Index blockRows,
-                              std::span<const std::array<Index, 2>> coupledPairs) {
+                              std::span<const std::array<Index, 2>> coupledPairs,
+                              std::span<const std::array<Index, 2>> isotropicPairs) {
   // Counting sort by row: first the number of candidate entries per row (diagonal + every
   // occurrence of the row in a pair, duplicates included), then fill, then sort and merge each row.
   std::vector<Index> candidateOffsets(static_cast<size_t>(blockRows) + 1, 0);
@@ -54,6 +56,13 @@ void BlockSparseMatrix::build(Index blockRows,
   }
   m_columns.shrink_to_fit();
   m_blocks.assign(m_columns.size(), Mat3::Zero());
+  m_isotropic.assign(m_columns.size(), 0);
+  for (const auto& [i, j] : isotropicPairs) {
+    if (i == j) continue;
+    for (const Index s : {slot(i, j), slot(j, i)}) {
+      if (s != kInvalidIndex) m_isotropic[s] = 1;
+    }
+  }
   // Unique across all matrices of the process, so a cache keyed on it cannot mistake a new
   // matrix (perhaps at the address of an old one) for the pattern it was built from.
   static std::atomic<std::uint64_t> nextPatternId{1};

@@ -13,6 +13,11 @@
 //   per-thread copies to run in parallel and changes the summation order with the thread count.
 //   With full rows SpMV is a per-row gather: each y[i] is summed by one thread in column order,
 //   so any split of the rows gives the same bits (multiplyRows is that split).
+// - Isotropic blocks. A block that every writer keeps a multiple of the identity (isometric
+//   bending's K̂_ij I₃ between vertices no membrane element shares: 12 of a grid row's 18
+//   off-diagonal blocks) is marked at build time (isotropic()). Storage stays one Mat3 a slot, so
+//   assembly and SpMV do not care; the Gauss–Seidel sweeps pack such a block as one scalar, a
+//   ninth of its bytes and a third of its multiplies.
 // - Rejected: Eigen::SparseMatrix<Real> of scalars (9× the index traffic, no 3×3 block kernels,
 //   and insertions that may allocate), and a hash map from (i, j) to a block (slow lookups in the
 //   assembly loop; slots make lookup a set-up cost).
@@ -35,14 +40,18 @@ class BlockSparseMatrix {
   /// An empty matrix (no rows); call build() before use.
   BlockSparseMatrix() = default;
 
-  /// Same as build(blockRows, coupledPairs).
-  BlockSparseMatrix(Index blockRows, std::span<const std::array<Index, 2>> coupledPairs);
+  /// Same as build(blockRows, coupledPairs, isotropicPairs).
+  BlockSparseMatrix(Index blockRows, std::span<const std::array<Index, 2>> coupledPairs,
+                    std::span<const std::array<Index, 2>> isotropicPairs = {});
 
   /// Builds the pattern: blockRows diagonal blocks plus blocks (i, j) and (j, i) for every pair.
   /// Duplicate pairs (in either order) are merged; a pair (i, i) names the diagonal, which is
   /// always present. Every index must be < blockRows (asserted; skipped in release builds).
+  /// isotropicPairs: pairs of coupledPairs whose two blocks the caller promises to keep multiples
+  /// of the identity (isotropic()); pairs not in coupledPairs and diagonal pairs are ignored.
   /// All blocks start at zero. Allocates; call at set-up time only.
-  void build(Index blockRows, std::span<const std::array<Index, 2>> coupledPairs);
+  void build(Index blockRows, std::span<const std::array<Index, 2>> coupledPairs,
+             std::span<const std::array<Index, 2>> isotropicPairs = {});
 
   /// Identifies the pattern: a fresh nonzero value at every build(), kept by copies, 0 before the
   /// first build. Lets pattern-dependent caches (MulticolorOrdering) know when to rebuild.
@@ -66,6 +75,10 @@ class BlockSparseMatrix {
 
   /// The block stored at a slot from slot() or diagonalSlot().
   const Mat3& block(Index slot) const { return m_blocks[slot]; }
+
+  /// True when the block at an off-diagonal slot is a multiple of the identity by construction
+  /// (build()'s isotropicPairs); its value is then block(slot)(0, 0) times I₃.
+  bool isotropic(Index slot) const { return m_isotropic[slot] != 0; }
 
   /// Sets every stored block to zero, keeping the pattern (the start of each assembly).
   void setZero();
@@ -105,6 +118,7 @@ class BlockSparseMatrix {
   std::vector<Index> m_columns;        ///< block column per slot, ascending within a row
   std::vector<Index> m_diagonalSlots;  ///< slot of (r, r) per row
   std::vector<Mat3> m_blocks;          ///< one block per slot
+  std::vector<std::uint8_t> m_isotropic;  ///< 1 on the slots of isotropic() blocks
   std::uint64_t m_patternId = 0;       ///< see patternId()
 };
 

@@ -4,6 +4,7 @@
 #include <solver/MulticolorOrdering.h>
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -192,40 +193,51 @@ PassSums updateRange(Index begin, Index end, Real alpha, const Vec3Array& c, con
 // --- colour share no block, so a colour's vertices can run in any order or at once. S_i on every
 // --- output keeps the vectors exactly in the free subspace (exact zeros for fixed vertices).
 
-/// The off-diagonal blocks of A in the ordering's sweep order (lower and upper entries), copied
-/// once per solve so the sweeps read them front to back.
-struct PackedBlocks {
-  const std::vector<Mat3>& lower;
-  const std::vector<Mat3>& upper;
-};
+/// Copies the blocks of the entries of sweep positions [begin, end) of one triangle into packed
+/// order: general blocks whole, isotropic ones as their scalar.
+void packTriangleRange(Index begin, Index end, const BlockSparseMatrix& A,
+                       const SweepTriangle& entries, PackedTriangle& packed) {
+  const SweepEntries& general = entries.general;
+  for (Index e = general.begin(begin), last = general.begin(end); e < last; ++e) {
+    packed.general[e] = A.block(general.slots[e]);
+  }
+  const SweepEntries& isotropic = entries.isotropic;
+  for (Index e = isotropic.begin(begin), last = isotropic.begin(end); e < last; ++e) {
+    const Mat3& block = A.block(isotropic.slots[e]);
+    assert(block == block(0, 0) * Mat3::Identity() && "an isotropic slot holds a general block");
+    packed.isotropic[e] = block(0, 0);
+  }
+}
 
-/// Copies the blocks of the entries of sweep positions [begin, end) into packed order.
-void packRange(Index begin, Index end, const BlockSparseMatrix& A,
-               const MulticolorOrdering& ordering, std::vector<Mat3>& lower,
-               std::vector<Mat3>& upper) {
-  for (Index e = ordering.lowerBegin(begin), last = ordering.lowerBegin(end); e < last; ++e) {
-    lower[e] = A.block(ordering.lowerSlots()[e]);
+/// Σ_j A_ij x_j over one triangle's entries of sweep position k: general blocks, then isotropic.
+inline Vec3 triangleProduct(Index k, const SweepTriangle& entries, const PackedTriangle& packed,
+                            const Vec3Array& x) {
+  Vec3 sum = Vec3::Zero();
+  const SweepEntries& general = entries.general;
+  const Index* columns = general.columns.data();
+  const Mat3* blocks = packed.general.data();
+  for (Index e = general.begin(k), last = general.begin(k + 1); e < last; ++e) {
+    sum.noalias() += blocks[e] * x[columns[e]];
   }
-  for (Index e = ordering.upperBegin(begin), last = ordering.upperBegin(end); e < last; ++e) {
-    upper[e] = A.block(ordering.upperSlots()[e]);
+  const SweepEntries& isotropic = entries.isotropic;
+  columns = isotropic.columns.data();
+  const Real* scalars = packed.isotropic.data();
+  for (Index e = isotropic.begin(k), last = isotropic.begin(k + 1); e < last; ++e) {
+    sum += scalars[e] * x[columns[e]];
   }
+  return sum;
 }
 
 /// Backward sweep over sweep positions [begin, end) of one colour, t = P_U⁻¹ c:
 /// t_i = D̃_i⁻¹(c_i − Σ_{later j} A_ij t_j), and u_i = S_i Σ_{later j} A_ij t_j = c_i − D̃_i t_i, the
 /// input of the forward sweep (stored in w).
-void backwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
+void backwardSweepRange(Index begin, Index end, const PackedTriangle& upper,
                         const MulticolorOrdering& ordering, const VertexFilter& filter,
                         const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c, Vec3Array& t,
                         Vec3Array& w) {
-  const Index* columns = ordering.upperColumns().data();
-  const Mat3* upper = blocks.upper.data();
   for (Index k = begin; k < end; ++k) {
     const Index vertex = ordering.order()[k];
-    Vec3 sum = Vec3::Zero();
-    for (Index e = ordering.upperBegin(k), last = ordering.upperBegin(k + 1); e < last; ++e) {
-      sum.noalias() += upper[e] * t[columns[e]];
-    }
+    const Vec3 sum = triangleProduct(k, ordering.upper(), upper, t);
     t[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * (c[vertex] - sum));
     w[vertex] = filter.filter(vertex, sum);
   }
@@ -235,19 +247,14 @@ void backwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
 /// w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j). With curvature, returns Σ c_iᵀ(t_i + w_i) over the
 /// range (ĉᵀÂĉ, Â = P_L⁻¹ Ã P_U⁻¹).
 template <bool curvature>
-Real forwardSweepRange(Index begin, Index end, const PackedBlocks& blocks,
+Real forwardSweepRange(Index begin, Index end, const PackedTriangle& lower,
                        const MulticolorOrdering& ordering, const VertexFilter& filter,
                        const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c,
                        const Vec3Array& t, Vec3Array& w) {
-  const Index* columns = ordering.lowerColumns().data();
-  const Mat3* lower = blocks.lower.data();
   Real sum = 0;
   for (Index k = begin; k < end; ++k) {
     const Index vertex = ordering.order()[k];
-    Vec3 rest = w[vertex];
-    for (Index e = ordering.lowerBegin(k), last = ordering.lowerBegin(k + 1); e < last; ++e) {
-      rest.noalias() -= lower[e] * w[columns[e]];
-    }
+    const Vec3 rest = w[vertex] - triangleProduct(k, ordering.lower(), lower, w);
     w[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * rest);
     if constexpr (curvature) sum += c[vertex].dot(t[vertex] + w[vertex]);
   }
@@ -286,19 +293,15 @@ PassSums transformedUpdateRange(Index begin, Index end, Real alpha, const BlockS
 /// The true residual r = P_L r̂ = ŝ + S L̃ r̂ (ŝ = D̃ r̂) over sweep positions [begin, end); returns
 /// Σ rᵀD̃⁻¹r (cg) and the stopping norm² (stop: the same, or Σ rᵀM⁻¹r for the velocity test).
 /// Positions are independent: any split gives the same bits.
-PassSums untransformedNormRange(Index begin, Index end, const PackedBlocks& blocks,
-                            const MulticolorOrdering& ordering, const VertexFilter& filter,
-                            const std::vector<Mat3>& inverseDiagonal,
-                            const MassWeights& weights, const Vec3Array& r, const Vec3Array& s) {
-  const Index* columns = ordering.lowerColumns().data();
-  const Mat3* lower = blocks.lower.data();
+PassSums untransformedNormRange(Index begin, Index end, const PackedTriangle& lower,
+                                const MulticolorOrdering& ordering, const VertexFilter& filter,
+                                const std::vector<Mat3>& inverseDiagonal,
+                                const MassWeights& weights, const Vec3Array& r,
+                                const Vec3Array& s) {
   PassSums sum;
   for (Index k = begin; k < end; ++k) {
     const Index vertex = ordering.order()[k];
-    Vec3 product = Vec3::Zero();
-    for (Index e = ordering.lowerBegin(k), last = ordering.lowerBegin(k + 1); e < last; ++e) {
-      product.noalias() += lower[e] * r[columns[e]];
-    }
+    const Vec3 product = triangleProduct(k, ordering.lower(), lower, r);
     const Vec3 residual = s[vertex] + filter.filter(vertex, product);
     sum.cg += residual.dot(inverseDiagonal[vertex] * residual);
     sum.stop += weights.active() ? weights.inverseMass[vertex] * residual.squaredNorm()
@@ -374,11 +377,15 @@ void FilteredPcg::prepareGaussSeidel(const BlockSparseMatrix& A) {
     // A new pattern or colouring (set-up, or a topology change): order it, size the packed
     // blocks. Allocates.
     m_ordering.build(A, m_rowColors);
-    m_lowerBlocks.resize(m_ordering.lowerSlots().size());
-    m_upperBlocks.resize(m_ordering.upperSlots().size());
+    for (auto [entries, packed] : {std::pair{&m_ordering.lower(), &m_lowerBlocks},
+                                   std::pair{&m_ordering.upper(), &m_upperBlocks}}) {
+      packed->general.resize(entries->general.size());
+      packed->isotropic.resize(entries->isotropic.size());
+    }
   }
   forEachBlock(A.blockRows(), [&](Index begin, Index end) {
-    packRange(begin, end, A, m_ordering, m_lowerBlocks, m_upperBlocks);
+    packTriangleRange(begin, end, A, m_ordering.lower(), m_lowerBlocks);
+    packTriangleRange(begin, end, A, m_ordering.upper(), m_upperBlocks);
   });
 }
 
@@ -391,7 +398,7 @@ Real FilteredPcg::forwardSweep(const VertexFilter& filter,
   for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
     sum += sumOverBlocks(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      return forwardSweepRange<curvature>(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering,
+      return forwardSweepRange<curvature>(first + begin, first + end, m_lowerBlocks, m_ordering,
                                           filter, m_inverseDiagonal, c, t, w);
     });
   }
@@ -403,7 +410,7 @@ void FilteredPcg::backwardSweep(const VertexFilter& filter,
   for (Index color = m_ordering.colorCount(); color-- > 0;) {
     const Index first = m_ordering.colorBegin(color);
     forEachBlock(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      backwardSweepRange(first + begin, first + end, PackedBlocks{m_lowerBlocks, m_upperBlocks}, m_ordering, filter,
+      backwardSweepRange(first + begin, first + end, m_upperBlocks, m_ordering, filter,
                          m_inverseDiagonal, c, t, w);
     });
   }
@@ -748,8 +755,7 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   const Real startNorm = report.residualNorm;
   auto exactNorms = [&] {
     return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return untransformedNormRange(begin, end, PackedBlocks{m_lowerBlocks, m_upperBlocks},
-                                    m_ordering, filter, m_inverseDiagonal, weights, r, s);
+      return untransformedNormRange(begin, end, m_lowerBlocks, m_ordering, filter, m_inverseDiagonal, weights, r, s);
     });
   };
 

@@ -33,7 +33,9 @@
 //   M, and Â ĉ = t + P_L⁻¹(ĉ − D̃ t), t = P_L⁻ᵀ ĉ, costs one backward and one forward half-sweep,
 //   i.e. one SpMV of work, instead of an SpMV plus two triangular solves. Δv is updated with t
 //   directly (Δv += α t), so nothing is transformed back at the end. The off-diagonal blocks are
-//   copied once per solve into sweep order so the sweeps stream. On the curtain it takes about
+//   copied once per solve into sweep order so the sweeps stream, an isotropic block
+//   (BlockSparseMatrix::isotropic(), isometric bending's 2-ring) as its one scalar: on a cloth
+//   grid that is 12 of a row's 18 off-diagonal blocks, so the sweeps move 40 % of the bytes. On the curtain it takes about
 //   half the iterations of block Jacobi (weft-solver-compare, bench/results/solver-defaults.md).
 //   Rejected: natural-order Gauss–Seidel and block IC(0) (sequential sweeps: no parallel version
 //   with the same bits), and multigrid (worth it only well beyond the ×16 curtain).
@@ -184,6 +186,13 @@ struct FilteredPcgMassWeights {
   bool active() const { return inverseMass != nullptr; }
 };
 
+/// One triangle of A's off-diagonal blocks (MulticolorOrdering's lower or upper entries) packed in
+/// sweep order: general blocks whole, isotropic ones as the scalar of their multiple of I₃.
+struct PackedTriangle {
+  std::vector<Mat3> general;
+  std::vector<Real> isotropic;
+};
+
 /// BW98 modified PCG with a filtered block-Jacobi or multicolour Gauss–Seidel preconditioner;
 /// owns its scratch.
 class FilteredPcg {
@@ -300,8 +309,8 @@ class FilteredPcg {
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
   std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
   MulticolorOrdering m_ordering;        ///< order of A's rows (Gauss–Seidel only)
-  std::vector<Mat3> m_lowerBlocks;      ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
-  std::vector<Mat3> m_upperBlocks;      ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
+  PackedTriangle m_lowerBlocks;         ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
+  PackedTriangle m_upperBlocks;         ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
   /// The velocity test's last w iterates, slot k mod w holding Δv_k (w · vertex count entries).
   Vec3Array m_progressRing;
   std::vector<Real> m_stopMass;         ///< kg, m_i of the velocity test (0 on fixed vertices)

@@ -117,23 +117,26 @@ void MulticolorOrdering::build(const BlockSparseMatrix& matrix, std::span<const 
 
   // Split of the off-diagonal slots, in sweep order. Neighbours never share a colour (that is
   // what the colouring guarantees), so every off-diagonal slot lands in exactly one of the lists.
-  m_lowerOffsets.assign(static_cast<size_t>(rows) + 1, 0);
-  m_upperOffsets.assign(static_cast<size_t>(rows) + 1, 0);
-  for (std::vector<Index>* list : {&m_lowerSlots, &m_lowerColumns, &m_upperSlots, &m_upperColumns}) {
-    list->clear();
-    list->reserve(matrix.blockCount() / 2);
+  for (SweepEntries* list : {&m_lower.general, &m_lower.isotropic, &m_upper.general,
+                             &m_upper.isotropic}) {
+    list->offsets.assign(static_cast<size_t>(rows) + 1, 0);
+    list->slots.clear();
+    list->columns.clear();
   }
   for (Index position = 0; position < rows; ++position) {
     const Index vertex = m_order[position];
     for (Index s = matrix.rowBegin(vertex); s < matrix.rowEnd(vertex); ++s) {
       const Index neighbour = matrix.column(s);
       if (neighbour == vertex) continue;
-      const bool lower = m_colors[neighbour] < m_colors[vertex];
-      (lower ? m_lowerSlots : m_upperSlots).push_back(s);
-      (lower ? m_lowerColumns : m_upperColumns).push_back(neighbour);
+      SweepTriangle& triangle = m_colors[neighbour] < m_colors[vertex] ? m_lower : m_upper;
+      SweepEntries& list = matrix.isotropic(s) ? triangle.isotropic : triangle.general;
+      list.slots.push_back(s);
+      list.columns.push_back(neighbour);
     }
-    m_lowerOffsets[position + 1] = static_cast<Index>(m_lowerSlots.size());
-    m_upperOffsets[position + 1] = static_cast<Index>(m_upperSlots.size());
+    for (SweepEntries* list : {&m_lower.general, &m_lower.isotropic, &m_upper.general,
+                               &m_upper.isotropic}) {
+      list->offsets[position + 1] = list->size();
+    }
   }
   m_patternId = matrix.patternId();
 }

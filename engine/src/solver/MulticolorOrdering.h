@@ -29,9 +29,11 @@
 // - What is stored. The vertices of each colour, ascending, one colour after another (`order`,
 //   `colorOffsets`), and for every row the slots of its blocks split by colour: `lower` slots
 //   (column of a smaller colour: the "L" part the forward sweep reads) and `upper` slots (larger
-//   colour: the "U" part of the backward sweep), listed in sweep order with their columns. The
-//   diagonal is in neither. FilteredPcg copies the blocks of these slots once per solve into
-//   arrays in the same order, so every sweep streams through memory front to back.
+//   colour: the "U" part of the backward sweep), listed in sweep order with their columns, and
+//   each split again into general blocks and isotropic ones (BlockSparseMatrix::isotropic()),
+//   which the sweeps store and multiply as scalars. The diagonal is in none. FilteredPcg copies
+//   the blocks of these slots once per solve into arrays in the same order, so every sweep streams
+//   through memory front to back.
 // - The ordering depends on the pattern and the given colours only, not on the values: build it
 //   once per topology (BlockSparseMatrix::patternId() tells when the pattern changed) and reuse it
 //   every step.
@@ -47,6 +49,23 @@
 #include <vector>
 
 namespace weft {
+
+/// Off-diagonal entries in sweep order: position k (vertex order()[k]) owns entries
+/// [begin(k), begin(k + 1)); entry e names the matrix slot (slots[e]) and the column vertex
+/// (columns[e]), so a sweep reads both arrays front to back.
+struct SweepEntries {
+  std::vector<Index> offsets;  ///< blockRows + 1 entries (per sweep position) into slots/columns
+  std::vector<Index> slots;    ///< matrix slot per entry
+  std::vector<Index> columns;  ///< column vertex per entry
+  Index begin(Index position) const { return offsets[position]; }
+  Index size() const { return static_cast<Index>(slots.size()); }
+};
+
+/// One triangle of the off-diagonal part (lower or upper), its general and isotropic blocks apart.
+struct SweepTriangle {
+  SweepEntries general;    ///< blocks stored as Mat3
+  SweepEntries isotropic;  ///< blocks that are multiples of the identity (stored as a scalar)
+};
 
 /// Colour classes of a block pattern plus the per-row split of its off-diagonal slots.
 class MulticolorOrdering {
@@ -82,20 +101,10 @@ class MulticolorOrdering {
   Index colorBegin(Index color) const { return m_colorOffsets[color]; }
   Index colorEnd(Index color) const { return m_colorOffsets[color + 1]; }
 
-  // The off-diagonal entries, in sweep order: position k = 0 … blockRows − 1 is vertex order()[k];
-  // its lower entries are [lowerBegin(k), lowerBegin(k + 1)), its upper ones likewise. Entry e
-  // names the matrix slot (lowerSlots()[e]) and the column vertex (lowerColumns()[e]), so a sweep
-  // reads both arrays front to back.
-
-  /// First lower entry (column of a smaller colour) of sweep position k.
-  Index lowerBegin(Index position) const { return m_lowerOffsets[position]; }
-  const std::vector<Index>& lowerSlots() const { return m_lowerSlots; }
-  const std::vector<Index>& lowerColumns() const { return m_lowerColumns; }
-
-  /// First upper entry (column of a larger colour) of sweep position k.
-  Index upperBegin(Index position) const { return m_upperOffsets[position]; }
-  const std::vector<Index>& upperSlots() const { return m_upperSlots; }
-  const std::vector<Index>& upperColumns() const { return m_upperColumns; }
+  /// Entries whose column has a smaller colour (the forward sweep's L̃), in sweep order.
+  const SweepTriangle& lower() const { return m_lower; }
+  /// Entries whose column has a larger colour (the backward sweep's Ũ), in sweep order.
+  const SweepTriangle& upper() const { return m_upper; }
 
  private:
   std::uint64_t m_patternId = 0;     ///< pattern this was built from; 0 = never built
@@ -104,12 +113,8 @@ class MulticolorOrdering {
   std::vector<Index> m_colors;        ///< colour per vertex
   std::vector<Index> m_order;         ///< vertices sorted by (colour, index)
   std::vector<Index> m_colorOffsets;  ///< colorCount + 1 entries into m_order
-  std::vector<Index> m_lowerOffsets;  ///< blockRows + 1 entries (per sweep position) into m_lower*
-  std::vector<Index> m_lowerSlots;    ///< slots with a smaller-colour column, in sweep order
-  std::vector<Index> m_lowerColumns;  ///< their columns
-  std::vector<Index> m_upperOffsets;  ///< blockRows + 1 entries (per sweep position) into m_upper*
-  std::vector<Index> m_upperSlots;    ///< slots with a larger-colour column, in sweep order
-  std::vector<Index> m_upperColumns;  ///< their columns
+  SweepTriangle m_lower;               ///< slots with a smaller-colour column, in sweep order
+  SweepTriangle m_upper;               ///< slots with a larger-colour column, in sweep order
 };
 
 }  // namespace weft
