@@ -9,8 +9,9 @@
 // fixed iteration count (tolerance 0), so set-up (preconditioner, packing) is left out.
 //
 // The bound is bytes / bandwidth. Bytes of one SpMV + preconditioner application: every stored
-// block and its column index (an isotropic block as one scalar, as the sweeps store it), the row offsets, the preconditioner's n diagonal blocks, and four
-// vectors of n Vec3 (x read and y written by the SpMV, r read and z written by the preconditioner).
+// block and its column index (an isotropic block as one scalar, as the sweeps store it), the row
+// offsets, the preconditioner's n diagonal blocks, and four vectors of n Vec3 (x read and y
+// written by the SpMV, r read and z written by the preconditioner).
 // The Gauss–Seidel iteration (Eisenstat's form) moves the same matrix bytes: its two half-sweeps
 // read every off-diagonal block once and D̃⁻¹ twice (the second read is left out: the bound stays
 // a lower bound). Bandwidth: a STREAM triad a = b + s·c,

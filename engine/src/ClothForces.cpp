@@ -215,12 +215,17 @@ void appendAllPairs(std::span<const Index> vertices, std::vector<std::array<Inde
 
 }  // namespace
 
-std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
+std::vector<std::array<Index, 2>> ClothForces::elementPairs() const {
   std::vector<std::array<Index, 2>> pairs;
   const auto addAll = [&pairs](std::span<const Index> vertices) { appendAllPairs(vertices, pairs); };
   for (const auto& element : m_triangles) addAll(element.vertices);
   for (const auto& element : m_hinges) addAll(element.vertices);
   for (const auto& element : m_springs) addAll(element.vertices);
+  return pairs;
+}
+
+std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
+  std::vector<std::array<Index, 2>> pairs = elementPairs();
   for (Index row = 0; row + 1 < Index(m_bendingRowOffsets.size()); ++row) {
     for (Index k = m_bendingRowOffsets[row]; k < m_bendingRowOffsets[row + 1]; ++k) {
       if (m_bendingEntries[k].column > row) pairs.push_back({row, m_bendingEntries[k].column});
@@ -232,13 +237,7 @@ std::vector<std::array<Index, 2>> ClothForces::coupledPairs() const {
 std::vector<std::array<Index, 2>> ClothForces::isotropicPairs() const {
   if (!m_isometricBending) return {};
   // Pairs some element holds write full blocks; sorted (smaller, larger) for the lookup.
-  std::vector<std::array<Index, 2>> general;
-  const auto addAll = [&general](std::span<const Index> vertices) {
-    appendAllPairs(vertices, general);
-  };
-  for (const auto& element : m_triangles) addAll(element.vertices);
-  for (const auto& element : m_hinges) addAll(element.vertices);
-  for (const auto& element : m_springs) addAll(element.vertices);
+  std::vector<std::array<Index, 2>> general = elementPairs();
   for (auto& pair : general) {
     if (pair[0] > pair[1]) std::swap(pair[0], pair[1]);
   }

@@ -124,6 +124,9 @@ class ClothForces {
   bool formsDampingJacobians() const { return m_damping; }
 
  private:
+  /// The pairs of coupledPairs() that triangles, hinges or springs hold (every pair of each
+  /// element, in element order): their blocks are general 3×3 blocks.
+  std::vector<std::array<Index, 2>> elementPairs() const;
   struct Pass;  // one evaluation: what to compute and where to put it
   Real evaluate(const Pass& pass) const;
   void buildIsometricBending();

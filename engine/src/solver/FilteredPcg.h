@@ -35,8 +35,9 @@
 //   directly (Δv += α t), so nothing is transformed back at the end. The off-diagonal blocks are
 //   copied once per solve into sweep order so the sweeps stream, an isotropic block
 //   (BlockSparseMatrix::isotropic(), isometric bending's 2-ring) as its one scalar: on a cloth
-//   grid that is 12 of a row's 18 off-diagonal blocks, so the sweeps move 40 % of the bytes. On the curtain it takes about
-//   half the iterations of block Jacobi (weft-solver-compare, bench/results/solver-defaults.md).
+//   grid that is 12 of a row's 18 off-diagonal blocks, so the sweeps read under half the bytes
+//   of full blocks. On the curtain it takes about half the iterations of block Jacobi
+//   (weft-solver-compare, bench/results/solver-defaults.md).
 //   Rejected: natural-order Gauss–Seidel and block IC(0) (sequential sweeps: no parallel version
 //   with the same bits), and multigrid (worth it only well beyond the ×16 curtain).
 // - Stopping, two tests (PcgStopping).
