@@ -1,6 +1,7 @@
 #include "ClothForces.h"
 
 #include "forces/BaraffWitkin.h"
+#include "forces/ChunkColouring.h"
 #include "forces/IsometricBending.h"
 #include "forces/SpringCondition.h"
 #include "forces/StretchLaw.h"
@@ -45,39 +46,21 @@ Eigen::Matrix<Real, 3 * N, 1> gatherVelocities(const std::array<Index, N>& verti
   return local;
 }
 
-// Greedy colouring in element order: each element takes the lowest colour none of its vertices
-// has used yet; then the elements are stably sorted by colour. Deterministic, and near the
-// minimum on meshes (a regular grid's triangles need 6, its hinges about 10). Colours are tracked
-// in a 64-bit mask per vertex; elements that find all 63 regular colours taken (vertices of
-// absurd valence) go to a last, overflow colour that runs as one serial block.
-constexpr Index kOverflowColour = 63;
-
+// Sorts the elements into the visiting order of ChunkColouring (one chunk per parallel block) and
+// returns the colours' offsets.
 template <typename ElementType>
 std::vector<Index> colourElements(std::vector<ElementType>& elements, Index vertexCount) {
-  std::vector<std::uint64_t> usedColours(vertexCount, 0);  // bit k: the vertex has colour k
-  std::vector<Index> colourOf(elements.size());
-  Index colourCount = 0;
-  for (std::size_t e = 0; e < elements.size(); ++e) {
-    std::uint64_t taken = 0;
-    for (Index vertex : elements[e].vertices) taken |= usedColours[vertex];
-    Index colour = 0;
-    while (colour < kOverflowColour && (taken >> colour & 1u)) ++colour;
-    colourOf[e] = colour;
-    for (Index vertex : elements[e].vertices) usedColours[vertex] |= std::uint64_t(1) << colour;
-    colourCount = std::max(colourCount, colour + 1);
-  }
-  std::vector<Index> order(elements.size());
-  for (std::size_t e = 0; e < order.size(); ++e) order[e] = Index(e);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](Index a, Index b) { return colourOf[a] < colourOf[b]; });
+  using Vertices = decltype(ElementType::vertices);
+  std::vector<Vertices> vertices;
+  vertices.reserve(elements.size());
+  for (const ElementType& element : elements) vertices.push_back(element.vertices);
+  ChunkColouring colouring =
+      colourChunks(std::span<const Vertices>(vertices), vertexCount, kGrainElements);
   std::vector<ElementType> sorted;
   sorted.reserve(elements.size());
-  for (Index e : order) sorted.push_back(elements[e]);
+  for (Index e : colouring.order) sorted.push_back(elements[e]);
   elements = std::move(sorted);
-  std::vector<Index> offsets(colourCount + 1, 0);
-  for (Index e : order) ++offsets[colourOf[e] + 1];
-  for (Index k = 0; k < colourCount; ++k) offsets[k + 1] += offsets[k];
-  return offsets;
+  return std::move(colouring.offsets);
 }
 
 }  // namespace
@@ -499,14 +482,15 @@ Real ClothForces::evaluate(const Pass& pass) const {
       },
       sum);
 
-  // One colour at a time: within a colour no two elements share a vertex, so their scatters
-  // never touch the same entry.
+  // One colour at a time, one chunk per block (forces/ChunkColouring.h): chunks of a colour share
+  // no vertex, so their scatters never touch the same entry.
   const auto forEachColour = [&](const std::vector<Index>& colours, auto&& elementRange) {
     for (std::size_t colour = 0; colour + 1 < colours.size(); ++colour) {
       const Index first = colours[colour];
       const Index count = colours[colour + 1] - first;
       // The overflow colour may hold elements that share vertices: one block, one thread.
-      const Index grain = colour == kOverflowColour ? std::max<Index>(count, 1) : kGrainElements;
+      const Index grain =
+          colour == ChunkColouring::kOverflowColour ? std::max<Index>(count, 1) : kGrainElements;
       energy += tasks.parallelReduce(
           count, grain, Real(0),
           [&](Index begin, Index end) { return elementRange(first + begin, first + end); }, sum);

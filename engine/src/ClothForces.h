@@ -16,18 +16,18 @@
 //   zeroed in the same pass, so the matrix is written row by row once before the elements add to
 //   it, with no separate zeroing sweep; bending needs no colouring (one writer per row).
 //
-// Parallel and deterministic: elements of each kind are coloured once (greedily, in model order)
-// so that no two elements of a colour share a vertex. A colour is then a parallelFor whose
-// elements write disjoint vertices and matrix blocks with no locks or atomics, and every force
-// entry and block receives its contributions in colour order, which does not depend on the thread
-// count. Energies are summed per fixed block and combined in block order (TaskSystem's ordered
-// reduction). So 1, 2 or 8 threads give the same bits. In Definite mode the matrix is also
+// Parallel and deterministic: elements of each kind are cut into chunks of consecutive elements
+// and the chunks coloured once (forces/ChunkColouring.h), so that no two chunks of a colour share
+// a vertex. A colour is then a parallelFor with one chunk per block: blocks write disjoint vertices
+// and matrix blocks with no locks or atomics, each chunk writes rows near each other, and every
+// force entry and block receives its contributions in an order fixed by the model, whatever the
+// thread count. Energies are summed per fixed block and combined in block order (TaskSystem's
+// ordered reduction). So 1, 2 or 8 threads give the same bits. In Definite mode the matrix is also
 // symmetric to the bit: a triangle writes block (j, i) as the transpose of the (i, j) it computed,
 // K̂ is symmetric, and blocks (i, j) and (j, i) receive their contributions in the same order.
 // Rejected: per-element buffers gathered per row (about 5 MB of extra traffic per assembly on the
-// curtain, where the whole assembly fits in cache), and per-thread copies of the matrix merged in a
-// fixed order (memory × threads, and a merge as costly as the SpMV). Colouring costs one fork/join
-// per colour: the curtain's triangles take 6 colours, its hinges 9 or so.
+// curtain), and per-thread copies of the matrix merged in a fixed order (memory × threads, and a
+// merge as costly as the SpMV). Colouring costs one fork/join per colour.
 #pragma once
 
 #include "forces/BaraffWitkin.h"

@@ -104,12 +104,14 @@ TEST(Cantilever, DenimBendsWithinItsPublishedBendingLength) {
   settings.overhangSegments = 16;
   const Real measured = CantileverScene::bendingLength(settings);
   RecordProperty("bending_length_cm", std::to_string(100 * measured));
-  EXPECT_LE(measured, highest);
   // The search brackets 41.5° by doubling the overhang, and the 4 cm strip it tries does not
-  // come to rest at the default tolerance (ALongDenimStripComesToRestAtTheDefaultSolverTolerance).
-  test::knownEngineFailure(measured >= lowest, "denim's D1388 bending length at least 1.63 cm",
-                           "1.60 cm: the bracket's 4 cm strip flails instead of resting at 55°, "
-                           "so the interpolation starts from a wrong angle (converged: 1.66 cm)");
+  // come to rest at the default tolerance (ALongDenimStripComesToRestAtTheDefaultSolverTolerance):
+  // where its flailing happens to stop moves the reading to either side of the range.
+  test::knownEngineFailure(measured >= lowest && measured <= highest,
+                           "denim's D1388 bending length within 1.63–1.92 cm",
+                           std::to_string(100 * measured) +
+                               " cm: the bracket's 4 cm strip flails instead of resting at 55°, so "
+                               "the interpolation starts from a wrong angle (converged: 1.66 cm)");
 }
 
 TEST(CusickDrape, TheDrapeCoefficientRisesWithTheBendingLength) {
