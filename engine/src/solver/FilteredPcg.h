@@ -306,6 +306,7 @@ class FilteredPcg {
   Vec3Array m_direction;         ///< c, the filtered search direction
   Vec3Array m_product;           ///< q = S A c (Gauss–Seidel: u, then w = P_L⁻¹ u)
   Vec3Array m_backward;          ///< t = P_U⁻¹ ĉ (Gauss–Seidel only)
+  std::vector<Mat3> m_diagonal;         ///< D̃_i per vertex: A's diagonal blocks, dense
   std::vector<Mat3> m_inverseDiagonal;  ///< D̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
   std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
