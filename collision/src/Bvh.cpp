@@ -248,32 +248,37 @@ inline bool Bvh::slotsShareVertex(Index slotA, Index slotB) const {
   return trianglesShareVertex(m_slotTriangles[slotA], m_slotTriangles[slotB]);
 }
 
-inline void Bvh::addSlotPair(Index slotA, Index slotB, std::vector<TrianglePair>& pairs) const {
+inline void Bvh::addSlotPair(Index slotA, Index slotB, const TrianglePairFilter& filter,
+                              std::vector<TrianglePair>& pairs) const {
   if (!m_slotBounds[slotA].overlaps(m_slotBounds[slotB]) || slotsShareVertex(slotA, slotB)) return;
   const Index a = m_triangleOrder[slotA];
   const Index b = m_triangleOrder[slotB];
-  pairs.push_back(a < b ? TrianglePair{a, b} : TrianglePair{b, a});
+  const TrianglePair pair = a < b ? TrianglePair{a, b} : TrianglePair{b, a};
+  if (filter.accepts && !filter.accepts(filter.context, pair.first, pair.second)) return;
+  pairs.push_back(pair);
 }
 
-void Bvh::selfNode(Index n, std::vector<TrianglePair>& pairs) const {
+void Bvh::selfNode(Index n, const TrianglePairFilter& filter,
+                   std::vector<TrianglePair>& pairs) const {
   const Node& node = m_nodes[n];
   if (!node.isLeaf()) {
-    selfNode(node.first, pairs);
-    selfNode(node.first + 1, pairs);
+    selfNode(node.first, filter, pairs);
+    selfNode(node.first + 1, filter, pairs);
     if (m_nodes[node.first].bounds.overlaps(m_nodes[node.first + 1].bounds)) {
-      selfPair(node.first, node.first + 1, pairs);
+      selfPair(node.first, node.first + 1, filter, pairs);
     }
     return;
   }
   const Index end = node.first + node.count;
   for (Index i = node.first; i < end; ++i) {
-    for (Index j = i + 1; j < end; ++j) addSlotPair(i, j, pairs);
+    for (Index j = i + 1; j < end; ++j) addSlotPair(i, j, filter, pairs);
   }
 }
 
 // Precondition: the boxes of nodes a and b overlap (checked by the caller, which saves a call
 // for every pair that does not).
-void Bvh::selfPair(Index a, Index b, std::vector<TrianglePair>& pairs) const {
+void Bvh::selfPair(Index a, Index b, const TrianglePairFilter& filter,
+                   std::vector<TrianglePair>& pairs) const {
   const Node& nodeA = m_nodes[a];
   const Node& nodeB = m_nodes[b];
   if (nodeA.isLeaf() && nodeB.isLeaf()) {
@@ -288,7 +293,7 @@ void Bvh::selfPair(Index a, Index b, std::vector<TrianglePair>& pairs) const {
     }
     for (Index i = nodeA.first; countB > 0 && i < nodeA.first + nodeA.count; ++i) {
       if (!m_slotBounds[i].overlaps(common)) continue;
-      for (Index k = 0; k < countB; ++k) addSlotPair(i, slotsB[k], pairs);
+      for (Index k = 0; k < countB; ++k) addSlotPair(i, slotsB[k], filter, pairs);
     }
     return;
   }
@@ -300,26 +305,28 @@ void Bvh::selfPair(Index a, Index b, std::vector<TrianglePair>& pairs) const {
   const Index other = descendA ? b : a;
   const Aabb& otherBounds = m_nodes[other].bounds;
   for (Index child = m_nodes[parent].first; child < m_nodes[parent].first + 2; ++child) {
-    if (m_nodes[child].bounds.overlaps(otherBounds)) selfPair(child, other, pairs);
+    if (m_nodes[child].bounds.overlaps(otherBounds)) selfPair(child, other, filter, pairs);
   }
 }
 
-void Bvh::runSelfTask(const NodePair& task, std::vector<TrianglePair>& pairs) const {
+void Bvh::runSelfTask(const NodePair& task, const TrianglePairFilter& filter,
+                      std::vector<TrianglePair>& pairs) const {
   if (task.first == task.second) {
-    selfNode(task.first, pairs);
+    selfNode(task.first, filter, pairs);
   } else if (m_nodes[task.first].bounds.overlaps(m_nodes[task.second].bounds)) {
-    selfPair(task.first, task.second, pairs);
+    selfPair(task.first, task.second, filter, pairs);
   }
 }
 
-void Bvh::querySelf(std::vector<TrianglePair>& pairs) const {
+void Bvh::querySelf(std::vector<TrianglePair>& pairs, const TrianglePairFilter& filter) const {
   pairs.clear();
-  for (const NodePair& task : m_selfTasks) runSelfTask(task, pairs);
+  for (const NodePair& task : m_selfTasks) runSelfTask(task, filter, pairs);
   detail::sortTrianglePairs(pairs, triangleCount());
 }
 
 void Bvh::querySelf(std::vector<TrianglePair>& pairs, TaskSystem& tasks,
-                    PerWorker<std::vector<TrianglePair>>& workerPairs) const {
+                    PerWorker<std::vector<TrianglePair>>& workerPairs,
+                    const TrianglePairFilter& filter) const {
   assert(workerPairs.size() >= tasks.threadCount() &&
          "Bvh::querySelf: build workerPairs from the TaskSystem that runs the query");
   for (int worker = 0; worker < workerPairs.size(); ++worker) workerPairs[worker].clear();
@@ -329,7 +336,7 @@ void Bvh::querySelf(std::vector<TrianglePair>& pairs, TaskSystem& tasks,
   tasks.parallelFor(static_cast<Index>(m_selfTasks.size()), 1,
                     [&](Index begin, Index end, int worker) {
                       for (Index t = begin; t < end; ++t) {
-                        runSelfTask(m_selfTasks[t], workerPairs[worker]);
+                        runSelfTask(m_selfTasks[t], filter, workerPairs[worker]);
                       }
                     });
   pairs.clear();

@@ -266,5 +266,53 @@ TEST(Bvh, ParallelRefitAndSelfQueryGiveTheSerialResult) {
   }
 }
 
+TEST(Bvh, AFilteredSelfQueryReportsExactlyThePairsTheFilterAccepts) {
+  // The filter sees every pair the plain query reports, as (smaller, larger), and only those;
+  // the result is the plain one without the refused pairs, in the same order, serial or parallel.
+  const MeshArrays mesh = test::makeGrid(41, 31, 0.05);
+  const std::vector<Vec3> oldX = test::fold(mesh.positions, 0.1, 0.5, 0.01, 1);
+  const std::vector<Vec3> newX = test::fold(mesh.positions, 0.12, 0.5, 0.01, 2);
+  Bvh tree = buildTree(mesh);
+  tree.refit(oldX, newX, 0.003);
+  std::vector<TrianglePair> all;
+  tree.querySelf(all);
+  ASSERT_GT(all.size(), 1000u);
+  struct Context {
+    std::vector<TrianglePair> asked;
+    bool misordered = false;
+  } context;
+  // Refuses pairs whose index sum is divisible by 3: a rule unrelated to the geometry.
+  const auto refuse = [](Index a, Index b) { return (a + b) % 3 == 0; };
+  const TrianglePairFilter recording{
+      [](const void* opaque, Index a, Index b) {
+        auto& c = *static_cast<Context*>(const_cast<void*>(opaque));
+        c.asked.push_back({a, b});
+        c.misordered = c.misordered || !(a < b);
+        return (a + b) % 3 != 0;
+      },
+      &context};
+  std::vector<TrianglePair> filtered;
+  tree.querySelf(filtered, recording);
+  std::sort(context.asked.begin(), context.asked.end());
+  EXPECT_EQ(context.asked, all) << "the filter is asked about exactly the plain query's pairs";
+  EXPECT_FALSE(context.misordered);
+  std::vector<TrianglePair> expected;
+  for (const TrianglePair& pair : all) {
+    if (!refuse(pair.first, pair.second)) expected.push_back(pair);
+  }
+  ASSERT_LT(expected.size(), all.size());
+  EXPECT_EQ(filtered, expected);
+
+  const TrianglePairFilter pure{
+      [](const void*, Index a, Index b) { return (a + b) % 3 != 0; }, nullptr};
+  for (int threads : {1, 2, 3}) {
+    TaskSystem tasks(TaskSystemSettings{threads});
+    PerWorker<std::vector<TrianglePair>> workerPairs(tasks);
+    std::vector<TrianglePair> pairs;
+    tree.querySelf(pairs, tasks, workerPairs, pure);
+    EXPECT_EQ(pairs, expected) << threads << " threads";
+  }
+}
+
 }  // namespace
 }  // namespace weft

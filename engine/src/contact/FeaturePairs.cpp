@@ -103,73 +103,17 @@ bool trianglesMayComeWithin(const TriangleMotion& a, std::span<const Vec3, 3> st
   return !(startOfB - endOfA - approach > std::numbers::sqrt3 * margin);
 }
 
-void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
-                                     const Vec3Array& to, Real inflate,
-                                     const std::vector<char>* dirty) {
-  WEFT_PROFILE_ZONE("broad phase");
-  m_bvh.refit(from, to, inflate, m_tasks);
-  m_refitCounts.refitNodes += m_bvh.lastRefitCounts().refitNodes;
-  m_refitCounts.skippedNodes += m_bvh.lastRefitCounts().skippedNodes;
-  Index dirtyTriangles = 0;
-  if (dirty) {
-    m_dirtyTriangle.resize(space.triangles.size());
-    for (std::size_t t = 0; t < space.triangles.size(); ++t) {
-      const auto& c = space.triangles[t];
-      m_dirtyTriangle[t] = (*dirty)[c[0]] | (*dirty)[c[1]] | (*dirty)[c[2]];
-      dirtyTriangles += m_dirtyTriangle[t] != 0;
-    }
-  }
-  if (dirty && dirtyTriangles * kBoxQueriesPerSelfQuery <= Index(space.triangles.size())) {
-    // Each dirty triangle's own box against the tree: the pairs the self query would report
-    // with it (the same leaf test), a pair of two dirty triangles taken from its lower one.
-    m_trianglePairs.clear();
-    const std::vector<Index>& order = m_bvh.triangleOrder();
-    for (Index slot = 0; slot < Index(order.size()); ++slot) {
-      const Index triangle = order[slot];
-      if (!m_dirtyTriangle[triangle]) continue;
-      m_bvh.queryBox(m_bvh.slotBounds(slot), m_boxHits);
-      for (Index other : m_boxHits) {
-        if (other == triangle || (m_dirtyTriangle[other] && other < triangle)) continue;
-        if (trianglesShareVertex(space.triangles[triangle], space.triangles[other])) continue;
-        m_trianglePairs.push_back({std::min(triangle, other), std::max(triangle, other)});
-      }
-    }
-    std::sort(m_trianglePairs.begin(), m_trianglePairs.end());
-  } else if (m_tasks && m_workerPairs) {
-    m_bvh.querySelf(m_trianglePairs, *m_tasks, *m_workerPairs);
-    // Which worker finds which pairs depends on scheduling: room for all in every worker's
-    // list, so allocation follows the number of pairs, never the timing of the threads.
-    const std::size_t total = m_trianglePairs.size();
-    m_workerPairs->forEach([total](std::vector<TrianglePair>& list) {
-      if (list.capacity() < total) list.reserve(total);
-    });
-  } else {
-    m_bvh.querySelf(m_trianglePairs);
-  }
-  std::erase_if(m_trianglePairs, [&](const TrianglePair& pair) {
-    if (dirty && !m_dirtyTriangle[pair.first] && !m_dirtyTriangle[pair.second]) return true;
-    return !space.pairsAllowed(space.triangles[pair.first][0], space.triangles[pair.second][0]);
-  });
-}
-
-void FeaturePairs::find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
-                        Real inflate, const std::vector<char>* dirty) {
-  findTrianglePairs(space, from, to, inflate, dirty);
-  collect(space, from, to, inflate, dirty);
-}
-
-void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
-                           Real margin, const std::vector<char>* dirty) {
-  WEFT_PROFILE_ZONE("feature pairs");
+void FeaturePairs::boxFeatures(const ContactSpace& space, const Vec3Array& from,
+                               const Vec3Array& to) {
+  // Every vertex's, triangle's and edge's box over the step, and every triangle's motion, once.
   const auto& triangles = space.triangles;
   const auto& edges = space.edges;
-  // Every vertex's, triangle's and edge's box over the step, once.
   const Index vertexCount = space.vertexCount();
   const Index triangleCount = Index(triangles.size()), edgeCount = Index(edges.size());
   auto boxVertices = [&](Index begin, Index end, int) {
     for (Index i = begin; i < end; ++i) m_vertexBoxes[i] = Aabb::fromCorners(from[i], to[i]);
   };
-  auto boxFeatures = [&](Index begin, Index end, int) {
+  auto boxElements = [&](Index begin, Index end, int) {
     for (Index i = begin; i < end; ++i) {
       if (i < triangleCount) {
         const auto& c = triangles[i];
@@ -190,11 +134,103 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
   };
   if (m_tasks) {
     m_tasks->parallelFor(vertexCount, kGrainVertices, boxVertices);
-    m_tasks->parallelFor(triangleCount + edgeCount, kGrainVertices, boxFeatures);
+    m_tasks->parallelFor(triangleCount + edgeCount, kGrainVertices, boxElements);
   } else {
     boxVertices(0, vertexCount, 0);
-    boxFeatures(0, triangleCount + edgeCount, 0);
+    boxElements(0, triangleCount + edgeCount, 0);
   }
+}
+
+bool FeaturePairs::mayTouch(const ContactSpace& space, const Vec3Array& from, Real margin,
+                            Index first, Index second) const {
+  const auto& a = space.triangles[first];
+  const auto& b = space.triangles[second];
+  if (!space.pairsAllowed(a[0], b[0])) return false;
+  const std::array<Vec3, 3> startA{from[a[0]], from[a[1]], from[a[2]]};
+  const std::array<Vec3, 3> startB{from[b[0]], from[b[1]], from[b[2]]};
+  return trianglesMayComeWithin(m_triangleMotions[first], startA, m_triangleMotions[second],
+                                startB, margin);
+}
+
+void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
+                                     const Vec3Array& to, Real inflate,
+                                     const std::vector<char>* dirty) {
+  WEFT_PROFILE_ZONE("broad phase");
+  m_bvh.refit(from, to, inflate, m_tasks);
+  m_refitCounts.refitNodes += m_bvh.lastRefitCounts().refitNodes;
+  m_refitCounts.skippedNodes += m_bvh.lastRefitCounts().skippedNodes;
+  Index dirtyTriangles = 0;
+  if (dirty) {
+    m_dirtyTriangle.resize(space.triangles.size());
+    for (std::size_t t = 0; t < space.triangles.size(); ++t) {
+      const auto& c = space.triangles[t];
+      m_dirtyTriangle[t] = (*dirty)[c[0]] | (*dirty)[c[1]] | (*dirty)[c[2]];
+      dirtyTriangles += m_dirtyTriangle[t] != 0;
+    }
+  }
+  // Pairs the space does not allow, and pairs that cannot come within the margin over the step
+  // (trianglesMayComeWithin), are dropped as the tree reports them: most overlapping boxes on a
+  // fine mesh belong to neighbours that move together, and dropping them there spares their
+  // merge, sort and scan.
+  struct FilterContext {
+    const FeaturePairs* pairs;
+    const ContactSpace* space;
+    const Vec3Array* from;
+    Real margin;
+  } context{this, &space, &from, inflate};
+  const TrianglePairFilter filter{
+      [](const void* opaque, Index a, Index b) {
+        const auto& c = *static_cast<const FilterContext*>(opaque);
+        return c.pairs->mayTouch(*c.space, *c.from, c.margin, a, b);
+      },
+      &context};
+  if (dirty && dirtyTriangles * kBoxQueriesPerSelfQuery <= Index(space.triangles.size())) {
+    // Each dirty triangle's own box against the tree: the pairs the self query would report
+    // with it (the same leaf test), a pair of two dirty triangles taken from its lower one.
+    m_trianglePairs.clear();
+    const std::vector<Index>& order = m_bvh.triangleOrder();
+    for (Index slot = 0; slot < Index(order.size()); ++slot) {
+      const Index triangle = order[slot];
+      if (!m_dirtyTriangle[triangle]) continue;
+      m_bvh.queryBox(m_bvh.slotBounds(slot), m_boxHits);
+      for (Index other : m_boxHits) {
+        if (other == triangle || (m_dirtyTriangle[other] && other < triangle)) continue;
+        if (trianglesShareVertex(space.triangles[triangle], space.triangles[other])) continue;
+        const TrianglePair pair{std::min(triangle, other), std::max(triangle, other)};
+        if (mayTouch(space, from, inflate, pair.first, pair.second)) m_trianglePairs.push_back(pair);
+      }
+    }
+    std::sort(m_trianglePairs.begin(), m_trianglePairs.end());
+  } else if (m_tasks && m_workerPairs) {
+    m_bvh.querySelf(m_trianglePairs, *m_tasks, *m_workerPairs, filter);
+    // Which worker finds which pairs depends on scheduling: room for all in every worker's
+    // list, so allocation follows the number of pairs, never the timing of the threads.
+    const std::size_t total = m_trianglePairs.size();
+    m_workerPairs->forEach([total](std::vector<TrianglePair>& list) {
+      if (list.capacity() < total) list.reserve(total);
+    });
+  } else {
+    m_bvh.querySelf(m_trianglePairs, filter);
+  }
+  if (dirty) {
+    std::erase_if(m_trianglePairs, [&](const TrianglePair& pair) {
+      return !m_dirtyTriangle[pair.first] && !m_dirtyTriangle[pair.second];
+    });
+  }
+}
+
+void FeaturePairs::find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
+                        Real inflate, const std::vector<char>* dirty) {
+  boxFeatures(space, from, to);
+  findTrianglePairs(space, from, to, inflate, dirty);
+  collect(space, inflate, dirty);
+}
+
+void FeaturePairs::collect(const ContactSpace& space, Real margin,
+                           const std::vector<char>* dirty) {
+  WEFT_PROFILE_ZONE("feature pairs");
+  const auto& triangles = space.triangles;
+  const auto& edges = space.edges;
   auto shares = [&](Index a, Index b) { return trianglesShareVertex(triangles[a], triangles[b]); };
   // Canonical ownership (see the file comment), tested cheaply: stop at the first candidate
   // that beats the pair at hand.
@@ -223,14 +259,6 @@ void FeaturePairs::collect(const ContactSpace& space, const Vec3Array& from, con
                           std::vector<std::array<Index, 2>>& edgeEdge) {
     for (Index k = begin; k < end; ++k) {
       const TrianglePair& pair = m_trianglePairs[k];
-      const auto& first = triangles[pair.first];
-      const auto& second = triangles[pair.second];
-      const std::array<Vec3, 3> firstStart{from[first[0]], from[first[1]], from[first[2]]};
-      const std::array<Vec3, 3> secondStart{from[second[0]], from[second[1]], from[second[2]]};
-      if (!trianglesMayComeWithin(m_triangleMotions[pair.first], firstStart,
-                                  m_triangleMotions[pair.second], secondStart, margin)) {
-        continue;
-      }
       const Aabb& firstBox = m_triangleBoxes[pair.first];
       const Aabb& secondBox = m_triangleBoxes[pair.second];
       // Every feature box of a triangle lies in its box: when the inflated triangle box misses

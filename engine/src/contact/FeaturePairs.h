@@ -86,10 +86,15 @@ class FeaturePairs {
   }
 
  private:
+  void boxFeatures(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to);
+  // Whether triangles first < second are allowed to meet and may come within `margin` over the
+  // step (the motions of boxFeatures()); only reads, so every worker of a query may ask at once.
+  bool mayTouch(const ContactSpace& space, const Vec3Array& from, Real margin, Index first,
+                Index second) const;
   void findTrianglePairs(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to,
                          Real inflate, const std::vector<char>* dirty);
-  void collect(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to, Real margin,
-               const std::vector<char>* dirty);
+  // The feature pairs of the triangle pairs found (their boxes from boxFeatures()).
+  void collect(const ContactSpace& space, Real margin, const std::vector<char>* dirty);
 
   TaskSystem* m_tasks = nullptr;
   Bvh m_bvh;
@@ -101,7 +106,7 @@ class FeaturePairs {
   std::vector<Index> m_vertexTriangleBegin, m_vertexTriangles;  // triangles around each vertex
   std::vector<std::array<Index, 2>> m_edgeTriangles;  // the triangles of each edge
   std::vector<Aabb> m_vertexBoxes, m_triangleBoxes, m_edgeBoxes;
-  std::vector<TriangleMotion> m_triangleMotions;  // per triangle, over the step of collect()
+  std::vector<TriangleMotion> m_triangleMotions;  // per triangle, over the step of boxFeatures()
   struct BlockFeatures {
     std::vector<std::array<Index, 2>> vertexTriangle, edgeEdge;
   };

@@ -94,6 +94,14 @@ struct TrianglePair {
   friend auto operator<=>(const TrianglePair&, const TrianglePair&) = default;
 };
 
+/// A test a self query applies to every pair (a < b) whose boxes overlap and that shares no
+/// vertex: the pairs it refuses are not reported. A plain function and its context, so the
+/// traversal is compiled once; it is called from every worker at once, so it must only read.
+struct TrianglePairFilter {
+  bool (*accepts)(const void* context, Index a, Index b) = nullptr;  ///< null: every pair
+  const void* context = nullptr;                                      ///< passed to accepts
+};
+
 /// True when triangles `a` and `b` (vertex indices) have a vertex in common. All nine comparisons
 /// without branches: the broad phase and the self-collision's feature pairs ask it for every
 /// candidate pair, with answers a branch predictor cannot guess.
@@ -159,13 +167,14 @@ class Bvh {
   /// What the last refit() recomputed and kept.
   const RefitCounts& lastRefitCounts() const { return m_lastRefit; }
 
-  /// Clears `pairs`, then writes every pair (i < j) of triangles whose boxes overlap and that
-  /// share no vertex, sorted.
-  void querySelf(std::vector<TrianglePair>& pairs) const;
+  /// Clears `pairs`, then writes every pair (i < j) of triangles whose boxes overlap, that
+  /// share no vertex and that `filter` accepts, sorted.
+  void querySelf(std::vector<TrianglePair>& pairs, const TrianglePairFilter& filter = {}) const;
   /// querySelf() with its tasks spread over `tasks`; `workerPairs` (built from the same
   /// TaskSystem, reused from call to call) collects each worker's pairs. Same result as serial.
   void querySelf(std::vector<TrianglePair>& pairs, TaskSystem& tasks,
-                 PerWorker<std::vector<TrianglePair>>& workerPairs) const;
+                 PerWorker<std::vector<TrianglePair>>& workerPairs,
+                 const TrianglePairFilter& filter = {}) const;
   /// Clears `pairs`, then writes every pair (triangle of this tree, triangle of `other`) whose
   /// boxes overlap, sorted. Both trees must be refit in the same frame of reference.
   void queryPairs(const Bvh& other, std::vector<TrianglePair>& pairs) const;
@@ -204,11 +213,15 @@ class Bvh {
   void refitTriangles(std::span<const Vec3> oldPositions, std::span<const Vec3> newPositions,
                       Real thickness, TaskSystem* tasks);
   void refitNodes(TaskSystem* tasks);
-  void runSelfTask(const NodePair& task, std::vector<TrianglePair>& pairs) const;
+  void runSelfTask(const NodePair& task, const TrianglePairFilter& filter,
+                   std::vector<TrianglePair>& pairs) const;
   bool slotsShareVertex(Index slotA, Index slotB) const;
-  void addSlotPair(Index slotA, Index slotB, std::vector<TrianglePair>& pairs) const;
-  void selfNode(Index node, std::vector<TrianglePair>& pairs) const;
-  void selfPair(Index a, Index b, std::vector<TrianglePair>& pairs) const;
+  void addSlotPair(Index slotA, Index slotB, const TrianglePairFilter& filter,
+                   std::vector<TrianglePair>& pairs) const;
+  void selfNode(Index node, const TrianglePairFilter& filter,
+                std::vector<TrianglePair>& pairs) const;
+  void selfPair(Index a, Index b, const TrianglePairFilter& filter,
+                std::vector<TrianglePair>& pairs) const;
 
   std::vector<std::array<Index, 3>> m_triangles;  // by triangle index
   std::vector<Index> m_triangleOrder;             // leaf slot -> triangle index
