@@ -6,9 +6,11 @@
 // A feature pair is reached through several triangle pairs; it is taken from one of them, its
 // canonical pair (vertex v against triangle B: the lowest triangle around v that shares no vertex
 // with B; edge a against edge b: the lowest pair of their triangles that shares none), so the
-// features come out each once, in the sorted order of the triangle pairs, with no sort. The
-// triangle pairs are found in parallel over fixed blocks and joined in block order: the same
-// lists on any thread count.
+// features come out each once, in the sorted order of the triangle pairs, with no sort. The tree
+// query drops a triangle pair as it reports it when the pair cannot come within the margin over
+// the step (trianglesMayComeWithin): on a fine mesh most overlapping boxes are neighbours moving
+// together. The feature pairs are found in parallel over fixed blocks of triangle pairs and
+// joined in block order: the same lists on any thread count.
 #pragma once
 
 #include "contact/ContactSpace.h"
