@@ -239,24 +239,40 @@ TEST(Bvh, BoxQueryEqualsBruteForce) {
   EXPECT_GT(nonEmpty, 25);
 }
 
+// The curtain's size, folded over a step: 2,400 triangles, so the triangle pass and the deep
+// levels split into several blocks, and over a thousand overlapping pairs.
+struct FoldedCurtain {
+  MeshArrays mesh = test::makeGrid(41, 31, 0.05);
+  std::vector<Vec3> oldX = test::fold(mesh.positions, 0.1, 0.5, 0.01, 1);
+  std::vector<Vec3> newX = test::fold(mesh.positions, 0.12, 0.5, 0.01, 2);
+  static constexpr Real kThickness = 0.003;  // m
+
+  // A tree over the mesh, refit to the step.
+  Bvh refitTree() const {
+    Bvh tree = buildTree(mesh);
+    tree.refit(oldX, newX, kThickness);
+    return tree;
+  }
+  // The unfiltered serial self query of `tree`.
+  static std::vector<TrianglePair> plainPairs(const Bvh& tree) {
+    std::vector<TrianglePair> pairs;
+    tree.querySelf(pairs);
+    EXPECT_GT(pairs.size(), 1000u) << "the test should exercise many overlaps";
+    return pairs;
+  }
+};
+
 TEST(Bvh, ParallelRefitAndSelfQueryGiveTheSerialResult) {
-  // The curtain's size: 2,400 triangles, so the triangle pass and the deep levels split into
-  // several blocks.
-  const MeshArrays mesh = test::makeGrid(41, 31, 0.05);
-  const std::vector<Vec3> oldX = test::fold(mesh.positions, 0.1, 0.5, 0.01, 1);
-  const std::vector<Vec3> newX = test::fold(mesh.positions, 0.12, 0.5, 0.01, 2);
-  Bvh serial = buildTree(mesh);
-  serial.refit(oldX, newX, 0.003);
-  std::vector<TrianglePair> expected;
-  serial.querySelf(expected);
-  ASSERT_GT(expected.size(), 1000u);
+  const FoldedCurtain curtain;
+  const Bvh serial = curtain.refitTree();
+  const std::vector<TrianglePair> expected = FoldedCurtain::plainPairs(serial);
   for (int threads : {1, 2, 3}) {
     TaskSystem tasks(TaskSystemSettings{threads});
     PerWorker<std::vector<TrianglePair>> workerPairs(tasks);
-    Bvh parallel = buildTree(mesh);
+    Bvh parallel = buildTree(curtain.mesh);
     std::vector<TrianglePair> pairs;
     for (int repeat = 0; repeat < 3; ++repeat) {
-      parallel.refit(oldX, newX, 0.003, &tasks);
+      parallel.refit(curtain.oldX, curtain.newX, FoldedCurtain::kThickness, &tasks);
       for (std::size_t n = 0; n < serial.nodes().size(); ++n) {
         ASSERT_EQ(parallel.nodes()[n].bounds, serial.nodes()[n].bounds) << threads << " threads";
       }
@@ -269,14 +285,8 @@ TEST(Bvh, ParallelRefitAndSelfQueryGiveTheSerialResult) {
 TEST(Bvh, AFilteredSelfQueryReportsExactlyThePairsTheFilterAccepts) {
   // The filter sees every pair the plain query reports, as (smaller, larger), and only those;
   // the result is the plain one without the refused pairs, in the same order, serial or parallel.
-  const MeshArrays mesh = test::makeGrid(41, 31, 0.05);
-  const std::vector<Vec3> oldX = test::fold(mesh.positions, 0.1, 0.5, 0.01, 1);
-  const std::vector<Vec3> newX = test::fold(mesh.positions, 0.12, 0.5, 0.01, 2);
-  Bvh tree = buildTree(mesh);
-  tree.refit(oldX, newX, 0.003);
-  std::vector<TrianglePair> all;
-  tree.querySelf(all);
-  ASSERT_GT(all.size(), 1000u);
+  const Bvh tree = FoldedCurtain().refitTree();
+  const std::vector<TrianglePair> all = FoldedCurtain::plainPairs(tree);
   struct Context {
     std::vector<TrianglePair> asked;
     bool misordered = false;
