@@ -201,7 +201,9 @@ void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array&
         if (other == triangle || (m_dirtyTriangle[other] && other < triangle)) continue;
         if (trianglesShareVertex(space.triangles[triangle], space.triangles[other])) continue;
         const TrianglePair pair{std::min(triangle, other), std::max(triangle, other)};
-        if (mayTouch(space, from, inflate, pair.first, pair.second)) m_trianglePairs.push_back(pair);
+        if (mayTouch(space, from, inflate, pair.first, pair.second)) {
+          m_trianglePairs.push_back(pair);
+        }
       }
     }
     std::sort(m_trianglePairs.begin(), m_trianglePairs.end());

@@ -761,7 +761,8 @@ void FilteredPcg::iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFil
   const Real startNorm = report.residualNorm;
   auto exactNorms = [&] {
     return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return untransformedNormRange(begin, end, m_lowerBlocks, m_ordering, filter, m_inverseDiagonal, weights, r, s);
+      return untransformedNormRange(begin, end, m_lowerBlocks, m_ordering, filter,
+                                    m_inverseDiagonal, weights, r, s);
     });
   };
 

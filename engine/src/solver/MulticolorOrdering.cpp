@@ -117,8 +117,9 @@ void MulticolorOrdering::build(const BlockSparseMatrix& matrix, std::span<const 
 
   // Split of the off-diagonal slots, in sweep order. Neighbours never share a colour (that is
   // what the colouring guarantees), so every off-diagonal slot lands in exactly one of the lists.
-  for (SweepEntries* list : {&m_lower.general, &m_lower.isotropic, &m_upper.general,
-                             &m_upper.isotropic}) {
+  SweepEntries* const lists[] = {&m_lower.general, &m_lower.isotropic, &m_upper.general,
+                                 &m_upper.isotropic};
+  for (SweepEntries* list : lists) {
     list->offsets.assign(static_cast<size_t>(rows) + 1, 0);
     list->slots.clear();
     list->columns.clear();
@@ -133,10 +134,7 @@ void MulticolorOrdering::build(const BlockSparseMatrix& matrix, std::span<const 
       list.slots.push_back(s);
       list.columns.push_back(neighbour);
     }
-    for (SweepEntries* list : {&m_lower.general, &m_lower.isotropic, &m_upper.general,
-                               &m_upper.isotropic}) {
-      list->offsets[position + 1] = list->size();
-    }
+    for (SweepEntries* list : lists) list->offsets[position + 1] = list->size();
   }
   m_patternId = matrix.patternId();
 }
