@@ -1,12 +1,11 @@
 // FeaturePairs, the self-collision's broad phase, against brute force on a sheet folded onto
 // itself and moving: every vertex–triangle and edge–edge pair that comes within the margin at
 // some sampled time of the step is reported, each once, and 1 and 2 threads report the same
-// lists in the same order. A feature pair is found through a pair of its triangles that share
-// no vertex; one with no such pair (a corner vertex against the triangle beside its only one)
-// is never reported, which is a known engine failure.
+// lists in the same order. The brute force also counts the pairs no pair of their triangles
+// sharing no vertex reaches (a corner vertex against the triangle beside its only one), which
+// FeaturePairs lists from the mesh: the sheet must hold some within the margin. Such a pair
+// within the pairs' reach at rest is left out by design (a neighbour in the material).
 #include "contact/FeaturePairs.h"
-
-#include "KnownEngineFailure.h"
 
 #include <weft/collision/Proximity.h>
 
@@ -117,7 +116,7 @@ TEST(FeaturePairs, EveryFeaturePairThatComesWithinTheMarginIsReportedOnce) {
     }
     return false;
   };
-  Index nearVt = 0, nearEe = 0, unreachable = 0;
+  Index nearVt = 0, nearEe = 0, neighbours = 0;
   for (Index vertex = 0; vertex < space.vertexCount(); ++vertex) {
     for (Index t = 0; t < Index(space.triangles.size()); ++t) {
       const auto& c = space.triangles[t];
@@ -129,8 +128,11 @@ TEST(FeaturePairs, EveryFeaturePairThatComesWithinTheMarginIsReportedOnce) {
       if (!near) continue;
       ++nearVt;
       if (!reachable(aroundVertex[vertex], {t})) {
-        unreachable += !reportedVt.count({vertex, t});
-        continue;
+        // A neighbour pair within the pairs' reach at rest is left out by design.
+        const Real rest = closestPointOnTriangle(space.rest[vertex], space.rest[c[0]],
+                                                 space.rest[c[1]], space.rest[c[2]]).distance;
+        if (rest < kPairReach * space.pairThickness(vertex, c[0])) continue;
+        ++neighbours;
       }
       EXPECT_TRUE(reportedVt.count({vertex, t})) << "vertex " << vertex << ", triangle " << t;
     }
@@ -147,8 +149,10 @@ TEST(FeaturePairs, EveryFeaturePairThatComesWithinTheMarginIsReportedOnce) {
       if (!near) continue;
       ++nearEe;
       if (!reachable(aroundEdge[a], aroundEdge[b])) {
-        unreachable += !reportedEe.count({a, b});
-        continue;
+        const Real rest = closestPointsOnSegments(space.rest[p[0]], space.rest[p[1]],
+                                                  space.rest[q[0]], space.rest[q[1]]).distance;
+        if (rest < kPairReach * space.pairThickness(p[0], q[0])) continue;
+        ++neighbours;
       }
       EXPECT_TRUE(reportedEe.count({a, b})) << "edges " << a << " and " << b;
     }
@@ -156,12 +160,7 @@ TEST(FeaturePairs, EveryFeaturePairThatComesWithinTheMarginIsReportedOnce) {
   // The fold brings the layers within the margin over most of the sheet.
   EXPECT_GT(nearVt, 200u);
   EXPECT_GT(nearEe, 200u);
-  test::knownEngineFailure(
-      unreachable == 0, "every feature pair within the margin is reported",
-      std::to_string(unreachable) +
-          " pair(s) within the margin whose triangles all touch the other feature's are never "
-          "tested (a corner vertex against the triangle beside its only one; 7.1 mm apart at "
-          "rest on this 1 cm mesh, so the narrow phase's rest exclusion does not cover them)");
+  EXPECT_GT(neighbours, 0u);
 }
 
 TEST(FeaturePairs, OneAndTwoThreadsReportTheSameListsInTheSameOrder) {

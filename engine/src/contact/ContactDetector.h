@@ -36,11 +36,6 @@
 
 namespace weft {
 
-/// Pairs of cloth features this many thicknesses apart at the substep start are contacts: one
-/// that approaches by up to a thickness within the substep is caught at the start, where its side
-/// is known. Features that close at rest are neighbours in the material and never a contact.
-inline constexpr Real kPairReach = 2;
-
 /// A pair that starts a substep closer than its thickness is asked back this fraction of the way
 /// to it in the substep (Bridson, Fedkiw & Anderson 2002's repulsion rate), by the projection and
 /// by the solve's penalty alike.

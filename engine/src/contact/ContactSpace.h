@@ -16,6 +16,11 @@
 
 namespace weft {
 
+/// Pairs of cloth features this many thicknesses apart at the substep start are contacts: one
+/// that approaches by up to a thickness within the substep is caught at the start, where its side
+/// is known. Features that close at rest are neighbours in the material and never a contact.
+inline constexpr Real kPairReach = 2;
+
 class Cloth;
 
 /// Per-cloth (owner) parameters of the contact space.

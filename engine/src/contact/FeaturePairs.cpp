@@ -1,5 +1,6 @@
 #include "contact/FeaturePairs.h"
 
+#include <weft/collision/Proximity.h>
 #include <weft/threading/GrainSizes.h>
 #include <weft/threading/Profiler.h>
 
@@ -66,6 +67,86 @@ void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
   m_triangleBoxes.resize(space.triangles.size());
   m_triangleMotions.resize(space.triangles.size());
   m_edgeBoxes.resize(space.edges.size());
+  listNeighbourPairs(space);
+}
+
+void FeaturePairs::listNeighbourPairs(const ContactSpace& space) {
+  // Only a feature whose triangles all touch a triangle of the other feature can be one: the
+  // candidates lie among the triangles around the corners of its own triangles.
+  const auto& triangles = space.triangles;
+  auto shares = [&](Index a, Index b) { return trianglesShareVertex(triangles[a], triangles[b]); };
+  auto around = [&](Index vertex) {
+    return std::span<const Index>(m_vertexTriangles.data() + m_vertexTriangleBegin[vertex],
+                                  m_vertexTriangles.data() + m_vertexTriangleBegin[vertex + 1]);
+  };
+  // Within the pairs' reach at rest: neighbours in the material, which the narrow phase never
+  // makes a contact (the elastic forces keep them apart). Left out here, the impact pass's swept
+  // test never meets them either: a sliver's tip lies within rounding of the next triangle,
+  // which that test reads as a hit at the start.
+  auto restNeighbours = [&](Index vertex, Index triangle) {
+    const auto& c = triangles[triangle];
+    const auto& r = space.rest;
+    return closestPointOnTriangle(r[vertex], r[c[0]], r[c[1]], r[c[2]]).distance <
+           kPairReach * space.pairThickness(vertex, c[0]);
+  };
+  std::vector<Index> candidates;
+  auto gatherTouching = [&](std::span<const Index> own) {
+    candidates.clear();
+    for (Index t : own) {
+      for (Index corner : triangles[t]) {
+        for (Index other : around(corner)) candidates.push_back(other);
+      }
+    }
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+  };
+  m_neighbourVertexTriangle.clear();
+  for (Index vertex = 0; vertex < space.vertexCount(); ++vertex) {
+    const std::span<const Index> own = around(vertex);
+    gatherTouching(own);
+    for (Index triangle : candidates) {
+      const auto& c = triangles[triangle];
+      if (c[0] == vertex || c[1] == vertex || c[2] == vertex || restNeighbours(vertex, triangle)) {
+        continue;
+      }
+      if (std::all_of(own.begin(), own.end(), [&](Index t) { return shares(t, triangle); })) {
+        m_neighbourVertexTriangle.push_back({vertex, triangle});
+      }
+    }
+  }
+  m_neighbourEdgeEdge.clear();
+  std::vector<Index> ownTriangles, edgeCandidates;
+  for (Index a = 0; a < Index(space.edges.size()); ++a) {
+    ownTriangles.clear();
+    for (Index t : m_edgeTriangles[a]) {
+      if (t != kInvalidIndex) ownTriangles.push_back(t);
+    }
+    gatherTouching(ownTriangles);
+    edgeCandidates.clear();
+    for (Index t : candidates) {
+      for (Index b : space.triangleEdges[t]) {
+        if (b > a) edgeCandidates.push_back(b);
+      }
+    }
+    std::sort(edgeCandidates.begin(), edgeCandidates.end());
+    edgeCandidates.erase(std::unique(edgeCandidates.begin(), edgeCandidates.end()),
+                         edgeCandidates.end());
+    const auto& p = space.edges[a];
+    for (Index b : edgeCandidates) {
+      const auto& q = space.edges[b];
+      if (p[0] == q[0] || p[0] == q[1] || p[1] == q[0] || p[1] == q[1]) continue;
+      const auto& r = space.rest;
+      if (closestPointsOnSegments(r[p[0]], r[p[1]], r[q[0]], r[q[1]]).distance <
+          kPairReach * space.pairThickness(p[0], q[0])) {
+        continue;
+      }
+      bool reached = false;
+      for (Index ta : ownTriangles) {
+        for (Index tb : m_edgeTriangles[b]) reached = reached || (tb != kInvalidIndex && !shares(ta, tb));
+      }
+      if (!reached) m_neighbourEdgeEdge.push_back({a, b});
+    }
+  }
 }
 
 TriangleMotion triangleMotion(std::span<const Vec3, 3> start, std::span<const Vec3, 3> end) {
@@ -311,21 +392,49 @@ void FeaturePairs::collect(const ContactSpace& space, Real margin,
   const Index pairCount = Index(m_trianglePairs.size());
   if (!m_tasks || m_tasks->isSerial() || pairCount <= kGrainTrianglePairs) {
     collectRange(0, pairCount, m_vertexTriangle, m_edgeEdge);
-    return;
+  } else {
+    const Index blocks = TaskSystem::blockCount(pairCount, kGrainTrianglePairs);
+    if (m_blockFeatures.size() < blocks) m_blockFeatures.resize(blocks);
+    m_tasks->parallelFor(pairCount, kGrainTrianglePairs, [&](Index begin, Index end, int) {
+      BlockFeatures& block = m_blockFeatures[begin / kGrainTrianglePairs];
+      block.vertexTriangle.clear();
+      block.edgeEdge.clear();
+      collectRange(begin, end, block.vertexTriangle, block.edgeEdge);
+    });
+    for (Index b = 0; b < blocks; ++b) {
+      const BlockFeatures& block = m_blockFeatures[b];
+      m_vertexTriangle.insert(m_vertexTriangle.end(), block.vertexTriangle.begin(),
+                              block.vertexTriangle.end());
+      m_edgeEdge.insert(m_edgeEdge.end(), block.edgeEdge.begin(), block.edgeEdge.end());
+    }
   }
-  const Index blocks = TaskSystem::blockCount(pairCount, kGrainTrianglePairs);
-  if (m_blockFeatures.size() < blocks) m_blockFeatures.resize(blocks);
-  m_tasks->parallelFor(pairCount, kGrainTrianglePairs, [&](Index begin, Index end, int) {
-    BlockFeatures& block = m_blockFeatures[begin / kGrainTrianglePairs];
-    block.vertexTriangle.clear();
-    block.edgeEdge.clear();
-    collectRange(begin, end, block.vertexTriangle, block.edgeEdge);
-  });
-  for (Index b = 0; b < blocks; ++b) {
-    const BlockFeatures& block = m_blockFeatures[b];
-    m_vertexTriangle.insert(m_vertexTriangle.end(), block.vertexTriangle.begin(),
-                            block.vertexTriangle.end());
-    m_edgeEdge.insert(m_edgeEdge.end(), block.edgeEdge.begin(), block.edgeEdge.end());
+  collectNeighbourPairs(space, margin, dirty);
+}
+
+void FeaturePairs::collectNeighbourPairs(const ContactSpace& space, Real margin,
+                                         const std::vector<char>* dirty) {
+  // Few (about one per boundary vertex of a grid), so one serial pass.
+  auto isDirty = [&](Index vertex) { return !dirty || (*dirty)[vertex]; };
+  for (const auto& [vertex, triangle] : m_neighbourVertexTriangle) {
+    const auto& c = space.triangles[triangle];
+    if (!space.pairsAllowed(vertex, c[0])) continue;
+    Aabb box = m_vertexBoxes[vertex];
+    box.inflate(margin);
+    if (box.overlaps(m_triangleBoxes[triangle]) &&
+        (isDirty(vertex) || isDirty(c[0]) || isDirty(c[1]) || isDirty(c[2]))) {
+      m_vertexTriangle.push_back({vertex, triangle});
+    }
+  }
+  for (const auto& [a, b] : m_neighbourEdgeEdge) {
+    const auto& p = space.edges[a];
+    const auto& q = space.edges[b];
+    if (!space.pairsAllowed(p[0], q[0])) continue;
+    Aabb box = m_edgeBoxes[a];
+    box.inflate(margin);
+    if (box.overlaps(m_edgeBoxes[b]) &&
+        (isDirty(p[0]) || isDirty(p[1]) || isDirty(q[0]) || isDirty(q[1]))) {
+      m_edgeEdge.push_back({a, b});
+    }
   }
 }
 

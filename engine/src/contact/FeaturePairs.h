@@ -6,7 +6,10 @@
 // A feature pair is reached through several triangle pairs; it is taken from one of them, its
 // canonical pair (vertex v against triangle B: the lowest triangle around v that shares no vertex
 // with B; edge a against edge b: the lowest pair of their triangles that shares none), so the
-// features come out each once, in the sorted order of the triangle pairs, with no sort. The tree
+// features come out each once, in the sorted order of the triangle pairs, with no sort. A few
+// feature pairs have no such triangle pair: every triangle of one feature touches every triangle
+// of the other (a corner vertex against the triangle beside its only one). These neighbour pairs
+// are listed once per build, from the mesh alone, and tested by their boxes after the rest. The tree
 // query drops a triangle pair as it reports it when the pair cannot come within the margin over
 // the step (trianglesMayComeWithin): on a fine mesh most overlapping boxes are neighbours moving
 // together. The feature pairs are found in parallel over fixed blocks of triangle pairs and
@@ -62,8 +65,8 @@ bool trianglesMayComeWithin(const TriangleMotion& a, std::span<const Vec3, 3> st
 
 class FeaturePairs {
  public:
-  /// Builds the tree over the space's triangles at its current positions, and the adjacency
-  /// tables; allocates (call when the space is rebuilt).
+  /// Builds the tree over the space's triangles at its current positions, the adjacency tables
+  /// and the neighbour pairs; allocates (call when the space is rebuilt).
   void build(const ContactSpace& space, TaskSystem* tasks);
 
   /// m: leaves whose triangles moved less than this since their last refit keep their boxes
@@ -76,7 +79,8 @@ class FeaturePairs {
   void find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to, Real inflate,
             const std::vector<char>* dirty = nullptr);
 
-  /// (vertex, triangle) and (edge, edge) pairs of the last find(), each once.
+  /// (vertex, triangle) and (edge, edge) pairs of the last find(), each once: those reached
+  /// through triangle pairs, then the neighbour pairs.
   const std::vector<std::array<Index, 2>>& vertexTriangle() const { return m_vertexTriangle; }
   const std::vector<std::array<Index, 2>>& edgeEdge() const { return m_edgeEdge; }
 
@@ -97,6 +101,10 @@ class FeaturePairs {
                          Real inflate, const std::vector<char>* dirty);
   // The feature pairs of the triangle pairs found (their boxes from boxFeatures()).
   void collect(const ContactSpace& space, Real margin, const std::vector<char>* dirty);
+  // The feature pairs that no pair of their triangles sharing no vertex reaches, from the mesh.
+  void listNeighbourPairs(const ContactSpace& space);
+  // Appends the neighbour pairs whose boxes come within `margin`.
+  void collectNeighbourPairs(const ContactSpace& space, Real margin, const std::vector<char>* dirty);
 
   TaskSystem* m_tasks = nullptr;
   Bvh m_bvh;
@@ -114,6 +122,7 @@ class FeaturePairs {
   };
   std::vector<BlockFeatures> m_blockFeatures;
   std::vector<std::array<Index, 2>> m_vertexTriangle, m_edgeEdge;
+  std::vector<std::array<Index, 2>> m_neighbourVertexTriangle, m_neighbourEdgeEdge;
 };
 
 }  // namespace weft
