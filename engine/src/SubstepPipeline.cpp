@@ -64,6 +64,7 @@ void addSubstepCounters(const StepStats& from, StepStats& to) {
   to.clothContacts += from.clothContacts;
   to.bvhNodesRefit += from.bvhNodesRefit;
   to.bvhNodesSkipped += from.bvhNodesSkipped;
+  to.squeezedVertices += from.squeezedVertices;
 }
 
 }  // namespace
@@ -214,6 +215,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     stats.status |= StepStatus::RetriedWithSmallerStep;
     substeps *= 2;
   }
+  if (stats.squeezedVertices > 0) stats.status |= StepStatus::Squeezed;
   const bool rolledBack = hasFlag(stats.status, StepStatus::RolledBack);
 
   // The frame's end: pins, sleep, the figures of the report.
@@ -430,6 +432,7 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   }
   stats.colliderNarrowPhases += counts.colliderPairsTested;
   stats.colliderNarrowPhasesSkipped += counts.colliderPairsSkipped;
+  stats.squeezedVertices += counts.squeezedVertices;
   stats.selfCollisionPasses += selfNeeded;
   stats.selfCollisionSkipped += selfSkipped;
   stats.contacts = projected.colliderContacts;

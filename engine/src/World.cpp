@@ -32,6 +32,7 @@ std::string describe(StepStatus status) {
   add(StepStatus::RetriedWithSmallerStep, "retried-with-smaller-step");
   add(StepStatus::BudgetMissed, "budget-missed");
   add(StepStatus::StrainLimitExceeded, "strain-limit-exceeded");
+  add(StepStatus::Squeezed, "squeezed");
   return text;
 }
 

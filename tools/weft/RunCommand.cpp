@@ -60,7 +60,8 @@ bool parseResolution(const std::string& text, int& width, int& height) {
 
 // Counts of each status flag over the run.
 struct StatusCounts {
-  unsigned unstable = 0, notConverged = 0, rolledBack = 0, retried = 0, invalid = 0, overLimit = 0;
+  unsigned unstable = 0, notConverged = 0, rolledBack = 0, retried = 0, invalid = 0, overLimit = 0,
+           squeezed = 0;
   void add(StepStatus s) {
     unstable += hasFlag(s, StepStatus::Unstable);
     notConverged += hasFlag(s, StepStatus::SolverNotConverged);
@@ -68,6 +69,7 @@ struct StatusCounts {
     retried += hasFlag(s, StepStatus::RetriedWithSmallerStep);
     invalid += hasFlag(s, StepStatus::InvalidInput);
     overLimit += hasFlag(s, StepStatus::StrainLimitExceeded);
+    squeezed += hasFlag(s, StepStatus::Squeezed);
   }
   std::string describe() const {
     std::string text;
@@ -80,6 +82,7 @@ struct StatusCounts {
     item(rolledBack, "rolled-back");
     item(invalid, "invalid-input");
     item(overLimit, "strain-limit-exceeded");
+    item(squeezed, "squeezed");
     return text.empty() ? "ok in every frame" : text;
   }
 };

@@ -23,6 +23,11 @@ constexpr Real kRestingFaceShell = 0.01;
 // A pair that passed through itself within the substep is put back on its side this share of its
 // thickness apart (the impact stage's separation).
 constexpr Real kImpactSeparation = 0.25;
+// Two collider contacts of a vertex whose normals meet at more than 120° (cosine below this)
+// face each other across the vertex: the room between the bodies along them is the sum of the
+// vertex's distances to both. A wider wedge leaves the vertex a way out, which the projection
+// finds.
+constexpr Real kOpposedNormals = -0.5;
 // Feature pairs per parallel block: a closest-point test costs ~50–100 ns, so 128 pairs are
 // 5–15 µs of work, above a fork/join.
 constexpr TaskSystem::Index kGrainFeaturePairs = 128;
@@ -164,7 +169,8 @@ void ContactDetector::detect(const ContactSpace& space, std::span<const Collider
   set.clear();
   selectNear(space, colliders, space.x, margin, counts);
   if (!m_near.empty()) {
-    detectColliderVertices(space, colliders, solveImpulses, constrainedCollider, margin, set);
+    detectColliderVertices(space, colliders, solveImpulses, constrainedCollider, margin, set,
+                           counts);
     detectColliderFaces(space, colliders, solveImpulses, constrainedCollider, margin, set);
   }
   set.firstPair = set.contacts.size();
@@ -175,11 +181,13 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
                                              std::span<const ColliderFrame> colliders,
                                              std::span<const Real> solveImpulses,
                                              std::span<const Index> constrainedCollider,
-                                             Real margin, ContactSet& set) {
+                                             Real margin, ContactSet& set,
+                                             DetectionCounts& counts) {
   for (Index i = 0; i < space.vertexCount(); ++i) {
     if (space.inverseMass[i] == 0) continue;
     const Real thickness = thicknessOf(space, i);
     const Real friction = space.owners[space.owner[i]].friction;
+    const std::size_t first = set.contacts.size();
     for (Index k : m_near) {
       const ColliderFrame& collider = colliders[k];
       const Vec3 start = collider.carry(space.startX[i]);
@@ -204,6 +212,24 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
       }
       set.contacts.push_back(contact);
     }
+    // Squeezed between two bodies closer than twice the thickness: no position keeps the
+    // thickness from both, and keeping it from one pushes the vertex into the other. Each
+    // contact keeps half the room instead, which holds the vertex midway, outside both.
+    bool squeezed = false;
+    for (std::size_t a = first; a < set.contacts.size(); ++a) {
+      for (std::size_t b = a + 1; b < set.contacts.size(); ++b) {
+        Contact& one = set.contacts[a];
+        Contact& other = set.contacts[b];
+        if (!(one.normal.dot(other.normal) < kOpposedNormals)) continue;
+        const Real room = one.gap + other.gap;
+        if (!(room < one.separation + other.separation)) continue;
+        const Real half = std::max<Real>(0, room / 2);
+        one.separation = std::min(one.separation, half);
+        other.separation = std::min(other.separation, half);
+        squeezed = true;
+      }
+    }
+    counts.squeezedVertices += squeezed;
   }
 }
 

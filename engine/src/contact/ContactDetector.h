@@ -66,6 +66,7 @@ struct FaceSupport {
 struct DetectionCounts {
   Index colliderPairsTested = 0;   ///< vertex sets tested against a collider's box hit
   Index colliderPairsSkipped = 0;  ///< colliders whose box missed the cloth's
+  Index squeezedVertices = 0;      ///< vertices between two colliders with too little room
 };
 
 class ContactDetector {
@@ -102,7 +103,7 @@ class ContactDetector {
   void detectColliderVertices(const ContactSpace& space, std::span<const ColliderFrame> colliders,
                               std::span<const Real> solveImpulses,
                               std::span<const Index> constrainedCollider, Real margin,
-                              ContactSet& set);
+                              ContactSet& set, DetectionCounts& counts);
   void detectColliderFaces(const ContactSpace& space, std::span<const ColliderFrame> colliders,
                            std::span<const Real> solveImpulses,
                            std::span<const Index> constrainedCollider, Real margin,

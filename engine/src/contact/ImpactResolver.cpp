@@ -87,7 +87,7 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
   Index corrected = 0;
   for (Index i = 0; i < space.vertexCount(); ++i) {
     if (space.inverseMass[i] == 0) continue;
-    const Real thickness = space.owners[space.owner[i]].thickness;
+    const Real thickness = m_colliderSeparation[i];
     bool moved = false;
     for (Index k : m_near) {
       const ColliderFrame& collider = colliders[k];
@@ -147,7 +147,7 @@ void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
   if (m_near.empty()) return;
   for (Index i = 0; i < space.vertexCount(); ++i) {
     if (!m_touched[i]) continue;
-    const Real thickness = space.owners[space.owner[i]].thickness;
+    const Real thickness = m_colliderSeparation[i];
     for (Index k : m_near) {
       // The way there, relative to the body, not only the end: an impulse may send a vertex
       // through a thin or fast body.
@@ -410,9 +410,18 @@ ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
   // round, and putting them back on it would undo the projection's strain limit.
   m_projected = space.x;
   m_tracked.assign(space.vertexCount(), 0);
+  // Each vertex is kept its thickness from every body, or less where the detection found it
+  // squeezed between two (its contacts' separation).
+  m_colliderSeparation.resize(space.vertexCount());
+  for (Index i = 0; i < space.vertexCount(); ++i) {
+    m_colliderSeparation[i] = space.owners[space.owner[i]].thickness;
+  }
   for (std::size_t c = 0; c < set.firstPair; ++c) {
     const Contact& contact = set.contacts[c];
-    if (contact.kind == ContactKind::VertexCollider) m_tracked[contact.vertices[0]] = 1;
+    if (contact.kind != ContactKind::VertexCollider) continue;
+    const Index i = contact.vertices[0];
+    m_tracked[i] = 1;
+    m_colliderSeparation[i] = std::min(m_colliderSeparation[i], contact.separation);
   }
   report.colliderCorrections = keepOutOfColliders(space, set, colliders);
   if (!pairs) return report;

@@ -117,6 +117,7 @@ class ImpactResolver {
   std::vector<char> m_touched;               // per vertex: v̄ changed
   Vec3Array m_projected;                     // x as the projection left it
   std::vector<char> m_tracked;               // per vertex: in a collider contact of the set
+  std::vector<Real> m_colliderSeparation;    // per vertex: how far it is kept from a body (m)
   std::vector<signed char> m_held;           // per vertex: −1 unknown, 0 free, 1 held
   std::vector<Index> m_zoneParent;           // union–find over vertices
   std::vector<char> m_inZone;

@@ -35,6 +35,10 @@ enum class StepStatus : std::uint32_t {
   /// loads demand more than the limit, or the limiter ran out of iterations. Take more
   /// substeps, move pins less far per frame, or raise the limit.
   StrainLimitExceeded = 1u << 6,
+  /// Two colliders closed on a cloth to less than twice its ClothMaterial::thickness: the
+  /// vertices between them were kept midway, closer than the thickness to both, never inside
+  /// either (see StepStats::squeezedVertices). Open the gap or thin the cloth.
+  Squeezed = 1u << 7,
 };
 
 constexpr StepStatus operator|(StepStatus a, StepStatus b) {
@@ -106,6 +110,9 @@ struct StepStats {
   /// Times the frame was redone with twice the substeps because a cloth ended it past its strain
   /// limit (SolverSettings::strainRetrySubsteps); `substeps` is what the kept attempt took.
   Index strainRetries = 0;
+  /// Vertices kept midway between two colliders closer than twice their thickness, summed over
+  /// substeps (StepStatus::Squeezed).
+  Index squeezedVertices = 0;
 
   // Frame budget (World::step(frameDt, budget) and World::step(frameDt, plan)).
   Real budgetMs = 0;           ///< ms, the budget this frame was given (0 = none)
