@@ -171,14 +171,9 @@ TEST(StressPins, PinsTeleportedTenMetresCarryTheClothThere) {
 // The dragged jump over draws: the jump changed by 0 … 3 mm (what bench/weft-teleport-perturb
 // --pin-teleport-distance 0 runs, there with pin removal on and off too). Every draw asserts the
 // stress conditions (strain from 2 s after the jump on) and that the energy is back within 1 %
-// of m·g·height for good within 2 s. In the draw of 0.1 mm the crash into the stopped
-// pins leaves a fold crushed in self-contact that a solve blind to the contacts keeps pushing
-// through the layer under it: the energy stays up. That condition is a known engine failure
-// there, with the figures measured (the stress conditions still asserted); with the contacts in
-// the solve (StressPins.PinsDraggedTenMetresRecoverWithSelfContactsInTheSolve) it holds.
+// of m·g·height for good within 2 s.
 struct DraggedDraw {
-  Real jumpOffset;        // m added to the 10 m jump
-  const char* knownFailure;  // why its recovery fails, with the figures; null: asserted
+  Real jumpOffset;  // m added to the 10 m jump
 };
 
 void PrintTo(const DraggedDraw& draw, std::ostream* out) { *out << "jump + " << draw.jumpOffset << " m"; }
@@ -200,21 +195,14 @@ TEST_P(StressPinsDragged, PinsDraggedTenMetresInOneFrameRecover) {
   const bool settled = outcome.settledAt >= 0 && outcome.settledAt <= 2.0;
   const std::string name = "dragged_pins_" + std::to_string(draw.jumpOffset);
   monitor.expectPasses(name, kCottonStrainLimit);
-  if (!draw.knownFailure) {
-    EXPECT_TRUE(settled) << "the energy is not back within 1 % of m·g·height for good within 2 s";
-    return;
-  }
-  knownEngineFailure(settled, "energy back within 1 % of m·g·height within 2 s", draw.knownFailure);
+  EXPECT_TRUE(settled) << "the energy is not back within 1 % of m·g·height for good within 2 s";
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Jumps, StressPinsDragged,
     ::testing::Values(
-        DraggedDraw{0, nullptr}, DraggedDraw{1e-6, nullptr}, DraggedDraw{1e-5, nullptr},
-        DraggedDraw{1e-4, "a fold crushed by the crash keeps stirring: energy not back within 1 % "
-                          "of m·g·height in 3 s (peak strain 0.14 in the crash)"},
-        DraggedDraw{1e-3, nullptr},
-        DraggedDraw{3e-3, nullptr}),
+        DraggedDraw{0}, DraggedDraw{1e-6}, DraggedDraw{1e-5}, DraggedDraw{1e-4},
+        DraggedDraw{1e-3}, DraggedDraw{3e-3}),
     [](const ::testing::TestParamInfo<DraggedDraw>& info) {
       const Real offset = info.param.jumpOffset;
       return std::string("plus_") + (offset == 0      ? "0"

@@ -29,7 +29,6 @@
 // is a failure of every scene.
 #pragma once
 
-#include "engine/KnownEngineFailure.h"
 #include "golden/GoldenHashes.h"
 
 #include <weft/collision/SelfIntersectionCounter.h>
@@ -67,9 +66,6 @@ inline std::shared_ptr<const ClothModel> horizontalSquare(Index vertices, Real s
   grid.heightAxis = Vec3(0, 0, -1);
   return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
 }
-
-/// A scene-specific check the engine is known to fail (engine/KnownEngineFailure.h).
-using test::knownEngineFailure;
 
 /// Watches the cloths of one world frame by frame and collects the five conditions.
 class StressMonitor {
