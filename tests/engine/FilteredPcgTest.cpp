@@ -535,8 +535,9 @@ TEST_P(FilteredPcgTest, VelocityErrorTestBoundsTheMassWeightedError) {
 // w-th on (a ring of the last w iterates), not only at multiples of w: a solve can end at any
 // iteration k ≥ w. Over a range of tolerances some solve must end between multiples of the
 // window, each with its mass-weighted error, against a direct solve, below the goal (tolerance ·
-// ‖Δv‖_M: the progress measures about the error w iterations back, which CG has since reduced),
-// and with the same bits on one and two threads.
+// ‖Δv‖_M: the progress measures about the error w iterations back, which CG has since reduced).
+// (A system this small is solved on the calling thread whatever the task system:
+// VelocityErrorSolvesAreBitwiseIdenticalOnOneAndTwoThreads checks the threads on a larger one.)
 TEST_P(FilteredPcgTest, VelocityErrorTestCanStopBetweenWindowEnds) {
   constexpr Index kVertices = 600;
   const RandomSystem system = makeRandomSystem(kVertices, 13);
@@ -550,7 +551,6 @@ TEST_P(FilteredPcgTest, VelocityErrorTestCanStopBetweenWindowEnds) {
   Vec3Array exact;
   ASSERT_TRUE(pcg.solve(system.A, system.b, filter, tightSettings(GetParam()), exact).converged);
   TaskSystem serial(TaskSystemSettings{1});
-  TaskSystem twoThreads(TaskSystemSettings{2});
   // Gauss–Seidel (the engine's) converges steadily here and its error stays below the goal
   // (measured: at most 0.56 of it). Block Jacobi crawls on this system (18–56 iterations), where
   // the window underestimates (header, "Stopping"): 1.5 and 1.6 times the goal at 1e-1 and 5e-2,
@@ -561,15 +561,9 @@ TEST_P(FilteredPcgTest, VelocityErrorTestCanStopBetweenWindowEnds) {
   for (Real tolerance : {1e-1, 5e-2, 3e-2, 2e-2, 1e-2, 5e-3, 3e-3, 2e-3, 1e-3}) {
     const PcgSettings settings = coldVelocitySettings(GetParam(), tolerance);
     Vec3Array one;
-    Vec3Array two;
     const SolveReport report = pcg.solve(system.A, system.b, filter, settings, one, &serial, masses);
-    const SolveReport reportTwo =
-        pcg.solve(system.A, system.b, filter, settings, two, &twoThreads, masses);
     ASSERT_TRUE(report.converged) << "tolerance " << tolerance;
     EXPECT_LE(report.relativeResidual, tolerance);
-    ASSERT_EQ(report.iterations, reportTwo.iterations) << "tolerance " << tolerance;
-    EXPECT_EQ(report.relativeResidual, reportTwo.relativeResidual);
-    for (Index i = 0; i < kVertices; ++i) ASSERT_EQ(one[i], two[i]) << "vertex " << i;
     if (report.iterations % settings.progressWindow != 0) ++betweenWindowEnds;
     Real error = 0;
     Real solution = 0;
@@ -582,6 +576,37 @@ TEST_P(FilteredPcgTest, VelocityErrorTestCanStopBetweenWindowEnds) {
     EXPECT_EQ(one[20], Vec3(0, -0.2, 0));
   }
   EXPECT_GT(betweenWindowEnds, 0);
+}
+
+// Above FilteredPcg::kMinParallelRows the solve's blocks run on the task system's threads: the
+// velocity-error solve (reductions of residual, progress and masses) gives the same bits on one
+// and two threads, and without a task system.
+TEST_P(FilteredPcgTest, VelocityErrorSolvesAreBitwiseIdenticalOnOneAndTwoThreads) {
+  constexpr Index kVertices = 2 * FilteredPcg::kMinParallelRows;
+  const RandomSystem system = makeRandomSystem(kVertices, 14);
+  VertexFilter filter;
+  filter.resize(kVertices);
+  filter.setFixed(20, Vec3(0, -0.2, 0));
+  filter.setConstrained(3000, Vec3(0, 1, 0), Vec3(0, 0.1, 0));
+  const std::vector<Real> masses(kVertices, 0.5);
+  TaskSystem serial(TaskSystemSettings{1});
+  TaskSystem twoThreads(TaskSystemSettings{2});
+  const PcgSettings settings = coldVelocitySettings(GetParam(), 1e-3);
+  FilteredPcg pcg;
+  Vec3Array reference;
+  const SolveReport expected =
+      pcg.solve(system.A, system.b, filter, settings, reference, nullptr, masses);
+  ASSERT_TRUE(expected.converged);
+  ASSERT_GT(expected.iterations, 1);
+  for (TaskSystem* tasks : {&serial, &twoThreads}) {
+    Vec3Array solution;
+    const SolveReport report = pcg.solve(system.A, system.b, filter, settings, solution, tasks, masses);
+    EXPECT_EQ(report.iterations, expected.iterations) << tasks->threadCount() << " thread(s)";
+    EXPECT_EQ(report.relativeResidual, expected.relativeResidual);
+    for (Index i = 0; i < kVertices; ++i) {
+      ASSERT_EQ(solution[i], reference[i]) << "vertex " << i << ", " << tasks->threadCount();
+    }
+  }
 }
 
 TEST_P(FilteredPcgTest, RepeatedSolvesGiveTheSameBits) {

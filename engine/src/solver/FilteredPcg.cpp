@@ -425,9 +425,9 @@ void FilteredPcg::backwardSweep(const VertexFilter& filter,
 void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
                                       PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
                                       TaskSystem* tasks) {
-  m_tasks = tasks;
   m_couplings = {};
   const Index vertexCount = A.blockRows();
+  m_tasks = vertexCount >= kMinParallelRows ? tasks : nullptr;
   if (m_residual.size() != vertexCount) resize(vertexCount);
   z.resize(vertexCount);
   forEachBlock(vertexCount, [&](Index begin, Index end) {
@@ -495,9 +495,9 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
                                std::span<const Real> masses,
                                std::span<const ContactCoupling> couplings) {
   SolveReport report;
-  m_tasks = tasks;
   m_couplings = {};
   const Index vertexCount = A.blockRows();
+  m_tasks = vertexCount >= kMinParallelRows ? tasks : nullptr;
   const bool velocityTest = settings.stopping == PcgStopping::VelocityError;
   // Validated rather than asserted: the contract says a mismatch is reported, not undefined.
   if (b.size() != vertexCount || filter.size() != vertexCount ||

@@ -202,6 +202,10 @@ class FilteredPcg {
   /// the thread count) so the summation order, and hence every bit of the result, is too; 256
   /// vertices of the four solver vectors (~24 KB) fit in L1/L2 and amortise a task's overhead.
   static constexpr Index kReductionBlock = 256;
+  /// A system of fewer rows (8 blocks) is solved on the calling thread: each of its parallel
+  /// calls would be a few blocks, whose fork and join cost more than a second thread saves. The
+  /// blocks and their order are the same, so are the bits.
+  static constexpr Index kMinParallelRows = 8 * kReductionBlock;
 
   /// Allocates scratch for vertexCount vertices; solve() then never allocates for that size.
   void resize(Index vertexCount);
