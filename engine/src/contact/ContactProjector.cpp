@@ -338,6 +338,15 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   // Friction at the face's centroid over the corners that are not on the body themselves (those
   // take it as vertex contacts), with the body's normal where the face touches it.
   const Real thickness = space.owners[space.owner[corner[0]]].thickness;
+  const FaceCore& core = set.cores[contact.core];
+  if (normal.isZero()) {
+    // A face that was not pushed and lies wholly beyond the touching distance takes none (the
+    // test below, for its friction point); told apart cheaply before the body is queried.
+    std::array<Vec3, 3> local;
+    for (int j = 0; j < 3; ++j) local[j] = collider.end.pose.toLocal(space.x[corner[j]]);
+    const Real touching = core.reach + (1 + kOnSurfaceShell) * thickness;
+    if (faceFartherThan(core, contact.normal, local[0], local[1], local[2], touching)) return depth;
+  }
   Vec3 b = Vec3::Zero();
   for (int j = 0; j < 3; ++j) {
     const bool onBody = queryPoint(collider.shape, space.x[corner[j]]).distance <
@@ -348,7 +357,6 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   b /= b.sum();
   if (normal.isZero()) {
     // Not pushed this sweep: the direction from the core to the face point now.
-    const FaceCore& core = set.cores[contact.core];
     Vec3 point = Vec3::Zero();
     for (int j = 0; j < 3; ++j) point += b[j] * space.x[corner[j]];
     const Vec3 local = collider.end.pose.toLocal(point);

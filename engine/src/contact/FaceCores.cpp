@@ -163,6 +163,8 @@ Real pushFaceOut(const FaceCore& core, const Vec3& cameFrom, const Pose& endPose
                  std::span<Vec3> x, std::span<Vec3> v, Real inverseStep, Vec3& normal) {
   std::array<FacePoint, 3> points;
   std::array<Vec3, 3> local;
+  for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
+  if (faceClearOfCore(core, cameFrom, local[0], local[1], local[2])) return 0;
   const auto findPoints = [&] {
     for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
     return facePoints(core, cameFrom, local[0], local[1], local[2],
@@ -189,6 +191,53 @@ Real pushFaceOut(const FaceCore& core, const Vec3& cameFrom, const Pose& endPose
     if (p + 1 < count) count = findPoints();
   }
   return deepest;
+}
+
+bool faceFartherThan(const FaceCore& core, const Vec3& direction, const Vec3& a, const Vec3& b,
+                     const Vec3& c, Real distance) {
+  // The gap between the boxes along an axis, and the gap along `direction`, each bound the
+  // distance from below; a part per billion keeps the answer safe from rounding.
+  const Real apart = distance * (1 + 1e-9) + 1e-12;
+  Aabb face = Aabb::fromCorners(a, b);
+  face.expand(c);
+  Aabb segment = Aabb::fromCorners(core.start, core.end);
+  segment.inflate(apart);
+  if (!face.overlaps(segment)) return true;
+  if (direction.isZero()) return false;
+  const Vec3 along = direction.normalized();
+  const Real faceLow = std::min({along.dot(a), along.dot(b), along.dot(c)});
+  const Real faceHigh = std::max({along.dot(a), along.dot(b), along.dot(c)});
+  const Real coreLow = std::min(along.dot(core.start), along.dot(core.end));
+  const Real coreHigh = std::max(along.dot(core.start), along.dot(core.end));
+  return faceLow - coreHigh > apart || coreLow - faceHigh > apart;
+}
+
+bool faceClearOfCore(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const Vec3& b,
+                     const Vec3& c) {
+  // A part per billion over the reach keeps the answer on the safe side of facePoints' rounding.
+  const Real clear = core.reach * (1 + 1e-9) + 1e-12;
+  if (!cameFrom.isZero()) {
+    // facePoints sends a face back to the side it came from, however far it crossed: only a gap
+    // along that side's direction, between every corner and both core ends, proves it clear.
+    // Each face and core point is then farther apart than that along it, and on that side.
+    const Vec3 along = cameFrom.normalized();
+    const Real face = std::min({along.dot(a), along.dot(b), along.dot(c)});
+    const Real coreEnd = std::max(along.dot(core.start), along.dot(core.end));
+    return face - coreEnd > clear;
+  }
+  // No side: the gap between the boxes along an axis, or the distance of the segment from the
+  // face's plane with both its ends on one side, bounds the distance from below.
+  Aabb face = Aabb::fromCorners(a, b);
+  face.expand(c);
+  Aabb segment = Aabb::fromCorners(core.start, core.end);
+  segment.inflate(clear);
+  if (!face.overlaps(segment)) return true;
+  const Vec3 plane = (b - a).cross(c - a);
+  const Real twiceArea = plane.norm();
+  if (!(twiceArea > 0)) return false;
+  const Real start = plane.dot(core.start - a) / twiceArea;
+  const Real end = plane.dot(core.end - a) / twiceArea;
+  return (start > clear && end > clear) || (start < -clear && end < -clear);
 }
 
 void appendMeshCores(const TriangleMeshShape& mesh, const Aabb& near, Real allowance,

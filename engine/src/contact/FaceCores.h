@@ -74,6 +74,17 @@ struct FacePoint {
 int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const Vec3& b,
                const Vec3& c, Real minDepth, std::array<FacePoint, 3>& points);
 
+/// True when face (a, b, c) is provably clear of the core (body frame): facePoints with the same
+/// `cameFrom` would find no point deeper than 0. A cheap test (a separating direction, boxes,
+/// the face's plane) that spares the exact one for the many cores a face lies clear of.
+bool faceClearOfCore(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const Vec3& b,
+                     const Vec3& c);
+
+/// True when every point of face (a, b, c) is provably farther than `distance` (m) from the
+/// core (body frame), by the boxes' gap or the gap along `direction` (zero: boxes only).
+bool faceFartherThan(const FaceCore& core, const Vec3& direction, const Vec3& a, const Vec3& b,
+                     const Vec3& c, Real distance);
+
 /// Σ b_k² w_k over a face's corners: the inverse mass of a face point against an immovable body.
 Real pointInverseMass(const Vec3& b, const std::array<Index, 3>& corner,
                       std::span<const Real> inverseMasses);
