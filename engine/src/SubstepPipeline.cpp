@@ -216,6 +216,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     substeps *= 2;
   }
   if (stats.squeezedVertices > 0) stats.status |= StepStatus::Squeezed;
+  if (stats.frozenVertices > 0) stats.status |= StepStatus::ContactsFrozen;
   const bool rolledBack = hasFlag(stats.status, StepStatus::RolledBack);
 
   // The frame's end: pins, sleep, the figures of the report.

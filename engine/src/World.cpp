@@ -33,6 +33,7 @@ std::string describe(StepStatus status) {
   add(StepStatus::BudgetMissed, "budget-missed");
   add(StepStatus::StrainLimitExceeded, "strain-limit-exceeded");
   add(StepStatus::Squeezed, "squeezed");
+  add(StepStatus::ContactsFrozen, "contacts-frozen");
   return text;
 }
 

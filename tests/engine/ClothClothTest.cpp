@@ -141,6 +141,28 @@ TEST(ClothCloth, WithoutTheSwitchTheLayersPassThroughEachOther) {
   EXPECT_EQ(layers.world.stats().clothContacts, 0u);
 }
 
+TEST(ClothCloth, TwoClothsCreatedOnEachOtherAreHeldStillAndTheFrameSaysSo) {
+  // Coincident from the start, every pair of the two cloths is a crossing no impulse or impact
+  // zone can part: the impact pass's last resort holds the vertices still, and the status and
+  // the stats report it rather than an ok frame.
+  World world;
+  GridSettings grid;
+  grid.columns = grid.rows = 5;
+  auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  (void)world.createCloth(model, ClothSettings{}).value();
+  (void)world.createCloth(model, ClothSettings{}).value();
+  const StepStatus status = world.step(kFrame);
+  EXPECT_GT(world.stats().frozenVertices, 0u);
+  EXPECT_TRUE(hasFlag(status, StepStatus::ContactsFrozen)) << describe(status);
+  EXPECT_NE(describe(status).find("contacts-frozen"), std::string::npos) << describe(status);
+  // A frame without such contacts carries no flag: one cloth alone.
+  World single;
+  (void)single.createCloth(model, ClothSettings{}).value();
+  const StepStatus alone = single.step(kFrame);
+  EXPECT_EQ(single.stats().frozenVertices, 0u);
+  EXPECT_FALSE(hasFlag(alone, StepStatus::ContactsFrozen)) << describe(alone);
+}
+
 TEST(ClothCloth, LayersWithDifferentSubstepCountsStayApart) {
   // The contact is resolved per frame over each cloth's whole frame, whatever its substeps.
   ClothSettings fine;

@@ -39,6 +39,11 @@ enum class StepStatus : std::uint32_t {
   /// vertices between them were kept midway, closer than the thickness to both, never inside
   /// either (see StepStats::squeezedVertices). Open the gap or thin the cloth.
   Squeezed = 1u << 7,
+  /// The impact pass's impulses and impact zones did not clear every crossing within their
+  /// passes, and its last resort held the rest's vertices at their substep start (see
+  /// StepStats::frozenVertices): nothing crossed, but those vertices stopped. Take more substeps
+  /// or raise the thickness if it persists.
+  ContactsFrozen = 1u << 8,
 };
 
 constexpr StepStatus operator|(StepStatus a, StepStatus b) {
@@ -95,7 +100,7 @@ struct StepStats {
   Index impactZones = 0;       ///< rigid impact-zone passes, the fail-safe (all substeps)
   /// Vertices the impact pass's last resort held at their step start because impulses and
   /// impact zones did not clear their contacts (all substeps): the contacts the engine did not
-  /// resolve physically. They never cross; they stop instead.
+  /// resolve physically. They never cross; they stop instead (StepStatus::ContactsFrozen).
   Index frozenVertices = 0;
   /// Sweeps of the contact projection (strain limits and contacts together), summed over
   /// substeps; 0 when no edge went over its limit and no contact was violated.
