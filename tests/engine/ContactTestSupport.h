@@ -34,6 +34,16 @@ inline std::shared_ptr<const ClothModel> horizontalSquare(Index vertices, Real s
   return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
 }
 
+/// An upright square of vertices × vertices in the plane z = 0, `size` m on a side, centred on
+/// the y axis with its bottom row (vertices 0 … vertices − 1) at height `bottom`.
+inline std::shared_ptr<const ClothModel> uprightSquare(Index vertices, Real size, Real bottom) {
+  GridSettings grid;
+  grid.columns = grid.rows = vertices;
+  grid.width = grid.height = size;
+  grid.origin = Vec3(-size / 2, bottom, 0);
+  return std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+}
+
 /// Appends a horizontal square grid of vertices × vertices centred on `centre` (front face +y)
 /// to `mesh`, for models made of several disconnected layers (ClothModel::fromMesh); returns the
 /// index of its first vertex.

@@ -33,11 +33,7 @@ class FastSphere : public ::testing::TestWithParam<std::tuple<Real, PinnedEdges>
 TEST_P(FastSphere, DoesNotPassThroughASheetPinnedOnItsEdges) {
   const auto [speed, edges] = GetParam();
   World world;
-  GridSettings grid;
-  grid.columns = grid.rows = kSide;
-  grid.width = grid.height = 1.0;
-  grid.origin = Vec3(-0.5, 0.5, 0);
-  auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  const auto model = test::uprightSquare(kSide, 1.0, 0.5);
   ClothSettings settings;
   // Tunnelling, not strain: the kinematic sphere, which nothing stops, carries the sheet's middle
   // metres past its pins.

@@ -232,11 +232,7 @@ TEST(StressRingThreads, ThreeStackedSheetsAreBitwiseTheSameOnOneAndTwoThreads) {
 
 TEST(StressContact, SphereAt250MetresPerSecondDoesNotTunnelThroughAPinnedSheet) {
   constexpr Index kVertices = 21;
-  GridSettings grid;
-  grid.columns = grid.rows = kVertices;
-  grid.width = grid.height = 1.0;
-  grid.origin = Vec3(-0.5, 0.5, 0);
-  auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  const auto model = test::uprightSquare(kVertices, 1.0, 0.5);
   ClothSettings settings;
   settings.material = cottonFabric();  // the stress suite runs cotton, strain limiter on
   for (Index k = 0; k < kVertices; ++k) {
