@@ -343,11 +343,7 @@ void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
     if (!(start.distance < kPairReach * thickness) && !sideChanged) return false;
     // Neighbours in the material (within the pairs' reach at rest): the elastic forces keep
     // them apart.
-    if (space.owner[vertex] == space.owner[c[0]] &&
-        closestPointOnTriangle(space.rest[vertex], space.rest[c[0]], space.rest[c[1]],
-                               space.rest[c[2]]).distance < kPairReach * thickness) {
-      return false;
-    }
+    if (space.restNeighbours(vertex, c)) return false;
     contact.kind = ContactKind::VertexFace;
     contact.vertices = {vertex, c[0], c[1], c[2]};
     contact.separation = thickness;
@@ -384,11 +380,7 @@ void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
     }
     const SegmentClosestPoints start = closestPointsOnSegments(x0[p[0]], x0[p[1]], x0[q[0]], x0[q[1]]);
     if (!(start.distance < kPairReach * thickness) && !sideChanged) return false;
-    if (space.owner[p[0]] == space.owner[q[0]] &&
-        closestPointsOnSegments(space.rest[p[0]], space.rest[p[1]], space.rest[q[0]],
-                                space.rest[q[1]]).distance < kPairReach * thickness) {
-      return false;
-    }
+    if (space.restNeighbours(p, q)) return false;
     contact.kind = ContactKind::EdgeEdge;
     contact.vertices = {p[0], p[1], q[0], q[1]};
     contact.separation = thickness;

@@ -2,6 +2,8 @@
 
 #include "Cloth.h"
 
+#include <weft/collision/Proximity.h>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -184,6 +186,20 @@ Aabb ContactSpace::movablePaths(std::span<const Vec3> end) const {
 
 Real ContactSpace::pairThickness(Index a, Index b) const {
   return std::max(owners[owner[a]].thickness, owners[owner[b]].thickness);
+}
+
+bool ContactSpace::restNeighbours(Index vertex, const std::array<Index, 3>& triangle) const {
+  const auto& c = triangle;
+  return owner[vertex] == owner[c[0]] &&
+         closestPointOnTriangle(rest[vertex], rest[c[0]], rest[c[1]], rest[c[2]]).distance <
+             kPairReach * pairThickness(vertex, c[0]);
+}
+
+bool ContactSpace::restNeighbours(const std::array<Index, 2>& p,
+                                  const std::array<Index, 2>& q) const {
+  return owner[p[0]] == owner[q[0]] &&
+         closestPointsOnSegments(rest[p[0]], rest[p[1]], rest[q[0]], rest[q[1]]).distance <
+             kPairReach * pairThickness(p[0], q[0]);
 }
 
 Real ContactSpace::pairFriction(Index a, Index b) const {

@@ -108,6 +108,11 @@ class ContactSpace {
   Real pairFriction(Index a, Index b) const;
   /// Whether pairs between these vertices' owners are detected.
   bool pairsAllowed(Index a, Index b) const;
+  /// Whether a vertex and a triangle, or two edges, of one cloth lie within the pairs' reach
+  /// (kPairReach thicknesses) of each other at rest: neighbours in the material, which the
+  /// elastic forces keep apart and no contact stage treats as a pair.
+  bool restNeighbours(Index vertex, const std::array<Index, 3>& triangle) const;
+  bool restNeighbours(const std::array<Index, 2>& p, const std::array<Index, 2>& q) const;
 
  private:
   void buildTethers(const Cloth& cloth, Index offset, Real factor);

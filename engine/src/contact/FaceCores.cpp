@@ -163,13 +163,15 @@ Real pushFaceOut(const FaceCore& core, const Vec3& cameFrom, const Pose& endPose
                  std::span<Vec3> x, std::span<Vec3> v, Real inverseStep, Vec3& normal) {
   std::array<FacePoint, 3> points;
   std::array<Vec3, 3> local;
-  for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
-  if (faceClearOfCore(core, cameFrom, local[0], local[1], local[2])) return 0;
-  const auto findPoints = [&] {
+  const auto toLocal = [&] {
     for (int j = 0; j < 3; ++j) local[j] = endPose.toLocal(x[corner[j]]);
+  };
+  const auto findPoints = [&] {
     return facePoints(core, cameFrom, local[0], local[1], local[2],
                       -std::numeric_limits<Real>::infinity(), points);
   };
+  toLocal();
+  if (faceClearOfCore(core, cameFrom, local[0], local[1], local[2])) return 0;
   Real deepest = 0;
   int count = findPoints();
   for (int p = 0; p < count; ++p) {
@@ -188,50 +190,63 @@ Real pushFaceOut(const FaceCore& core, const Vec3& cameFrom, const Pose& endPose
       deepest = point.depth;
       normal = direction;
     }
-    if (p + 1 < count) count = findPoints();
+    if (p + 1 < count) {
+      toLocal();
+      count = findPoints();
+    }
   }
   return deepest;
 }
 
-bool faceFartherThan(const FaceCore& core, const Vec3& direction, const Vec3& a, const Vec3& b,
-                     const Vec3& c, Real distance) {
-  // The gap between the boxes along an axis, and the gap along `direction`, each bound the
-  // distance from below; a part per billion keeps the answer safe from rounding.
-  const Real apart = distance * (1 + 1e-9) + 1e-12;
+namespace {
+
+// `distance` with a part per billion to spare: a lower bound that beats it by this is beyond the
+// rounding of the exact tests.
+Real withRoundingSlack(Real distance) { return distance * (1 + 1e-9) + 1e-12; }
+
+// Whether the boxes of face (a, b, c) and of the core are more than `distance` apart along an
+// axis, which bounds the distance between them from below.
+bool boxesApart(const FaceCore& core, const Vec3& a, const Vec3& b, const Vec3& c, Real distance) {
   Aabb face = Aabb::fromCorners(a, b);
   face.expand(c);
   Aabb segment = Aabb::fromCorners(core.start, core.end);
-  segment.inflate(apart);
-  if (!face.overlaps(segment)) return true;
+  segment.inflate(distance);
+  return !face.overlaps(segment);
+}
+
+// How far every corner of face (a, b, c) lies beyond both core ends along the unit vector
+// `along` (negative: not all of it does).
+Real gapAlong(const Vec3& along, const FaceCore& core, const Vec3& a, const Vec3& b,
+              const Vec3& c) {
+  return std::min({along.dot(a), along.dot(b), along.dot(c)}) -
+         std::max(along.dot(core.start), along.dot(core.end));
+}
+
+}  // namespace
+
+bool faceFartherThan(const FaceCore& core, const Vec3& direction, const Vec3& a, const Vec3& b,
+                     const Vec3& c, Real distance) {
+  // The gap between the boxes along an axis, and the gap along `direction` on either side, each
+  // bound the distance from below.
+  const Real apart = withRoundingSlack(distance);
+  if (boxesApart(core, a, b, c, apart)) return true;
   if (direction.isZero()) return false;
   const Vec3 along = direction.normalized();
-  const Real faceLow = std::min({along.dot(a), along.dot(b), along.dot(c)});
-  const Real faceHigh = std::max({along.dot(a), along.dot(b), along.dot(c)});
-  const Real coreLow = std::min(along.dot(core.start), along.dot(core.end));
-  const Real coreHigh = std::max(along.dot(core.start), along.dot(core.end));
-  return faceLow - coreHigh > apart || coreLow - faceHigh > apart;
+  return gapAlong(along, core, a, b, c) > apart || gapAlong(-along, core, a, b, c) > apart;
 }
 
 bool faceClearOfCore(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const Vec3& b,
                      const Vec3& c) {
-  // A part per billion over the reach keeps the answer on the safe side of facePoints' rounding.
-  const Real clear = core.reach * (1 + 1e-9) + 1e-12;
+  const Real clear = withRoundingSlack(core.reach);
   if (!cameFrom.isZero()) {
     // facePoints sends a face back to the side it came from, however far it crossed: only a gap
     // along that side's direction, between every corner and both core ends, proves it clear.
     // Each face and core point is then farther apart than that along it, and on that side.
-    const Vec3 along = cameFrom.normalized();
-    const Real face = std::min({along.dot(a), along.dot(b), along.dot(c)});
-    const Real coreEnd = std::max(along.dot(core.start), along.dot(core.end));
-    return face - coreEnd > clear;
+    return gapAlong(cameFrom.normalized(), core, a, b, c) > clear;
   }
   // No side: the gap between the boxes along an axis, or the distance of the segment from the
   // face's plane with both its ends on one side, bounds the distance from below.
-  Aabb face = Aabb::fromCorners(a, b);
-  face.expand(c);
-  Aabb segment = Aabb::fromCorners(core.start, core.end);
-  segment.inflate(clear);
-  if (!face.overlaps(segment)) return true;
+  if (boxesApart(core, a, b, c, clear)) return true;
   const Vec3 plane = (b - a).cross(c - a);
   const Real twiceArea = plane.norm();
   if (!(twiceArea > 0)) return false;

@@ -1,6 +1,5 @@
 #include "contact/FeaturePairs.h"
 
-#include <weft/collision/Proximity.h>
 #include <weft/threading/GrainSizes.h>
 #include <weft/threading/Profiler.h>
 
@@ -79,16 +78,10 @@ void FeaturePairs::listNeighbourPairs(const ContactSpace& space) {
     return std::span<const Index>(m_vertexTriangles.data() + m_vertexTriangleBegin[vertex],
                                   m_vertexTriangles.data() + m_vertexTriangleBegin[vertex + 1]);
   };
-  // Within the pairs' reach at rest: neighbours in the material, which the narrow phase never
-  // makes a contact (the elastic forces keep them apart). Left out here, the impact pass's swept
-  // test never meets them either: a sliver's tip lies within rounding of the next triangle,
-  // which that test reads as a hit at the start.
-  auto restNeighbours = [&](Index vertex, Index triangle) {
-    const auto& c = triangles[triangle];
-    const auto& r = space.rest;
-    return closestPointOnTriangle(r[vertex], r[c[0]], r[c[1]], r[c[2]]).distance <
-           kPairReach * space.pairThickness(vertex, c[0]);
-  };
+  // Pairs that are neighbours at rest (ContactSpace::restNeighbours), which the narrow phase
+  // never makes a contact, are left out, so the impact pass's swept test never meets them
+  // either: a sliver's tip lies within rounding of the next triangle, which that test reads as
+  // a hit at the start.
   std::vector<Index> candidates;
   auto gatherTouching = [&](std::span<const Index> own) {
     candidates.clear();
@@ -106,7 +99,7 @@ void FeaturePairs::listNeighbourPairs(const ContactSpace& space) {
     gatherTouching(own);
     for (Index triangle : candidates) {
       const auto& c = triangles[triangle];
-      if (c[0] == vertex || c[1] == vertex || c[2] == vertex || restNeighbours(vertex, triangle)) {
+      if (c[0] == vertex || c[1] == vertex || c[2] == vertex || space.restNeighbours(vertex, c)) {
         continue;
       }
       if (std::all_of(own.begin(), own.end(), [&](Index t) { return shares(t, triangle); })) {
@@ -135,11 +128,7 @@ void FeaturePairs::listNeighbourPairs(const ContactSpace& space) {
     for (Index b : edgeCandidates) {
       const auto& q = space.edges[b];
       if (p[0] == q[0] || p[0] == q[1] || p[1] == q[0] || p[1] == q[1]) continue;
-      const auto& r = space.rest;
-      if (closestPointsOnSegments(r[p[0]], r[p[1]], r[q[0]], r[q[1]]).distance <
-          kPairReach * space.pairThickness(p[0], q[0])) {
-        continue;
-      }
+      if (space.restNeighbours(p, q)) continue;
       bool reached = false;
       for (Index ta : ownTriangles) {
         for (Index tb : m_edgeTriangles[b]) reached = reached || (tb != kInvalidIndex && !shares(ta, tb));

@@ -427,7 +427,7 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
                                       TaskSystem* tasks) {
   m_couplings = {};
   const Index vertexCount = A.blockRows();
-  m_tasks = vertexCount >= kMinParallelRows ? tasks : nullptr;
+  m_tasks = tasksFor(vertexCount, tasks);
   if (m_residual.size() != vertexCount) resize(vertexCount);
   z.resize(vertexCount);
   forEachBlock(vertexCount, [&](Index begin, Index end) {
@@ -497,7 +497,7 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   SolveReport report;
   m_couplings = {};
   const Index vertexCount = A.blockRows();
-  m_tasks = vertexCount >= kMinParallelRows ? tasks : nullptr;
+  m_tasks = tasksFor(vertexCount, tasks);
   const bool velocityTest = settings.stopping == PcgStopping::VelocityError;
   // Validated rather than asserted: the contract says a mismatch is reported, not undefined.
   if (b.size() != vertexCount || filter.size() != vertexCount ||

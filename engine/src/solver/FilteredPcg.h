@@ -243,6 +243,11 @@ class FilteredPcg {
                            TaskSystem* tasks = nullptr);
 
  private:
+  // The task system a system of `rows` rows runs on: none below kMinParallelRows.
+  static TaskSystem* tasksFor(Index rows, TaskSystem* tasks) {
+    return rows >= kMinParallelRows ? tasks : nullptr;
+  }
+
   /// Runs kernel(begin, end) over the fixed reduction blocks of [0, count) (all vertices, or a
   /// colour's vertex list) and returns the sum of the returned partials, combined in block order
   /// (the deterministic reduction).
