@@ -2,13 +2,15 @@
 // cloth on the analytic shape of its size, in one process.
 //
 //   build/bench/weft-mesh-colliders [--frames 120] [--repeats 3] [--threads 1] [--self true]
-//                                   [--queries true] [--scenes sphere,cylinder]
+//                                   [--queries true] [--scenes sphere,cylinder,large]
 //
-// Two pairs of scenes, each a cloth dropped from rest onto a body at the origin and draping:
+// Pairs of scenes, each a cloth dropped from rest onto a body at the origin and draping:
 //   sphere    41 × 41 vertices (1,681), 1.2 m square, 0.5 m up, on a 0.3 m sphere: the analytic
 //             Sphere against a UV sphere of 6,048 triangles on the same radius (closed);
 //   cylinder  35 × 35 vertices (1,225), 1.2 m square, 0.5 m up, on a 0.6 m-tall body: an
-//             analytic Box 0.6 m on a side against a 258-triangle cylinder of radius 0.3 m.
+//             analytic Box 0.6 m on a side against a 258-triangle cylinder of radius 0.3 m;
+//   large     71 × 71 vertices (5,041) on the 0.3 m sphere against a UV sphere of 19,800
+//             triangles: a garment and a game character's mesh, in size (not run by default).
 // The configurations alternate (A, M, A, M, …) so that a machine shared with other jobs slows
 // both alike; a run's cost is the calling thread's CPU time per frame of World::step (and the
 // wall time), the smallest of the repeats is kept, and every repeat's M / A ratio is printed.
@@ -111,6 +113,7 @@ struct RunFigures {
   double wallMs = 0;  ///< wall time of step() per frame
   Real maxStrain = 0;
   Index contacts = 0;  ///< vertices in contact at the last frame
+  Real faceContacts = 0;  ///< face contacts per frame (StepStats::faceContacts), mean
 
   void keepFaster(const RunFigures& other) {
     cpuMs = std::min(cpuMs, other.cpuMs);
@@ -133,6 +136,7 @@ RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, 
     figures.cpuMs += threadCpuMs() - cpu;
     figures.wallMs += wallMs() - wall;
     figures.maxStrain = std::max(figures.maxStrain, world.stats().maxStrain);
+    figures.faceContacts += Real(world.stats().faceContacts) / frames;
   }
   figures.cpuMs /= frames;
   figures.wallMs /= frames;
@@ -159,10 +163,14 @@ void compare(const std::string& scene, const std::string& analyticName, const Sh
       m.keepFaster(rm);
     }
   }
-  std::printf("  %-9s best: %-22s cpu %8.3f wall %8.3f ms/frame (strain %.4f, contacts %u)\n",
-              scene.c_str(), analyticName.c_str(), a.cpuMs, a.wallMs, a.maxStrain, a.contacts);
-  std::printf("  %-9s best: %-22s cpu %8.3f wall %8.3f ms/frame (strain %.4f, contacts %u)\n",
-              scene.c_str(), meshName.c_str(), m.cpuMs, m.wallMs, m.maxStrain, m.contacts);
+  std::printf("  %-9s best: %-22s cpu %8.3f wall %8.3f ms/frame (strain %.4f, contacts %u, "
+              "face contacts %.0f/frame)\n",
+              scene.c_str(), analyticName.c_str(), a.cpuMs, a.wallMs, a.maxStrain, a.contacts,
+              a.faceContacts);
+  std::printf("  %-9s best: %-22s cpu %8.3f wall %8.3f ms/frame (strain %.4f, contacts %u, "
+              "face contacts %.0f/frame)\n",
+              scene.c_str(), meshName.c_str(), m.cpuMs, m.wallMs, m.maxStrain, m.contacts,
+              m.faceContacts);
   std::printf("  %-9s ratio mesh / analytic (best cpu): %.2f\n\n", scene.c_str(), m.cpuMs / a.cpuMs);
 }
 
@@ -203,12 +211,12 @@ int main(int argc, char** argv) {
   int frames = 120;
   int repeats = 3;
   int threads = 1;
-  std::string scenes = "sphere,cylinder";
+  std::string scenes = "sphere,cylinder";  // "large" on request
   app.add_option("--frames", frames, "Frames per run")->check(CLI::Range(1, 100000));
   app.add_option("--repeats", repeats, "Runs per configuration (fastest kept)")
       ->check(CLI::Range(1, 20));
   app.add_option("--threads", threads, "Threads (1 = serial)")->check(CLI::Range(1, 64));
-  app.add_option("--scenes", scenes, "sphere, cylinder or both (comma-separated)");
+  app.add_option("--scenes", scenes, "sphere, cylinder, large (comma-separated)");
   bool self = true;
   app.add_option("--self", self, "Self-collision on (true/false)");
   bool queries = true;
@@ -226,6 +234,15 @@ int main(int argc, char** argv) {
             "UV sphere (" + std::to_string(ball.indices.size() / 3) + " tris)", mesh, 41, frames,
             repeats, threads, self);
     if (queries) queryCost(analytic, mesh, kRadius);
+  }
+  if (scenes.find("large") != std::string::npos) {
+    // The game-sized case: a 5,000-vertex garment on a 20,000-triangle body.
+    const Mesh ball = uvSphere(kRadius, 100, 100);
+    const Shape analytic = Sphere::create(kRadius).value();
+    const Shape mesh = TriangleMeshShape::create(ball.vertices, ball.indices).value();
+    compare("large", "Sphere", analytic,
+            "UV sphere (" + std::to_string(ball.indices.size() / 3) + " tris)", mesh, 71, frames,
+            repeats, threads, self);
   }
   if (scenes.find("cylinder") != std::string::npos) {
     const Mesh post = cylinder(kRadius, 2 * kRadius, 43, 2);

@@ -153,7 +153,10 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
   }
   std::sort(edgeSlots.begin(), edgeSlots.end());
   geometry->edgeNormals.assign(edgeSlots.size(), Vec3::Zero());
+  geometry->triangleEdges.assign(edgeSlots.size(), 0);
   geometry->closed = true;
+  // Per edge: its signed turn (positive convex, infinite on a border or fin) and width.
+  std::vector<std::pair<Real, Real>> turnAndWidth;
   for (std::size_t begin = 0; begin < edgeSlots.size();) {
     std::size_t end = begin;
     Vec3 sum = Vec3::Zero();
@@ -164,11 +167,68 @@ Result<TriangleMeshShape> TriangleMeshShape::create(std::span<const Vec3> localV
     // Closed: every edge has exactly two triangles (a border edge has one, a fin three or more).
     if (end - begin != 2) geometry->closed = false;
     if (sum.squaredNorm() > 0) sum.normalize();
-    for (std::size_t i = begin; i < end; ++i) geometry->edgeNormals[edgeSlots[i].second] = sum;
+    MeshEdge edge;
+    edge.a = Index(edgeSlots[begin].first >> 32);
+    edge.b = Index(edgeSlots[begin].first & 0xffffffffu);
+    for (std::size_t i = begin; i < end; ++i) {
+      geometry->edgeNormals[edgeSlots[i].second] = sum;
+      geometry->triangleEdges[edgeSlots[i].second] = Index(geometry->edges.size());
+    }
+    turnAndWidth.push_back(edgeTurnAndWidth(*geometry, edge,
+                                            std::span(edgeSlots).subspan(begin, end - begin)));
+    geometry->edges.push_back(edge);
     begin = end;
   }
+  setEdgeShapes(*geometry, turnAndWidth);
   shape.m_geometry = std::move(geometry);
   return shape;
+}
+
+std::pair<Real, Real> TriangleMeshShape::edgeTurnAndWidth(
+    const Geometry& geometry, const MeshEdge& edge,
+    std::span<const std::pair<std::uint64_t, Index>> slots) {
+  const Real infinity = std::numeric_limits<Real>::infinity();
+  if (slots.size() != 2) return {infinity, 0};
+  const auto& x = geometry.vertices;
+  const Real length = (x[edge.b] - x[edge.a]).norm();
+  Real width = infinity;
+  for (const auto& slot : slots) {
+    const Vec3* corner = &geometry.corners[3 * (slot.second / 3)];
+    width = std::min(width, (corner[1] - corner[0]).cross(corner[2] - corner[0]).norm() / length);
+  }
+  const Index first = slots[0].second / 3, second = slots[1].second / 3;
+  const Vec3& n1 = geometry.faceNormals[first];
+  const Vec3& n2 = geometry.faceNormals[second];
+  const Real turn = std::atan2(n1.cross(n2).norm(), n1.dot(n2));
+  // The second triangle's far corner below the first's plane: the edge is convex.
+  Real farSide = 0;
+  for (int k = 0; k < 3; ++k) farSide += n1.dot(geometry.corners[3 * second + k] - x[edge.a]);
+  return {farSide < 0 ? turn : -turn, width};
+}
+
+void TriangleMeshShape::setEdgeShapes(Geometry& geometry,
+                                      std::span<const std::pair<Real, Real>> turnAndWidth) {
+  const Real infinity = std::numeric_limits<Real>::infinity();
+  for (std::size_t e = 0; e < geometry.edges.size(); ++e) {
+    MeshEdge& edge = geometry.edges[e];
+    const auto [turn, width] = turnAndWidth[e];
+    // A closed mesh's concave edge lies below the faces beside it; an open mesh is a shell whose
+    // both sides are outside, so either turn is convex from one of them.
+    const Real convexTurn = geometry.closed ? std::max<Real>(turn, 0) : std::abs(turn);
+    edge.ridgeSlope = std::isinf(convexTurn) ? infinity : std::tan(convexTurn / 2);
+    edge.curvature = std::isinf(convexTurn) ? infinity : edge.ridgeSlope / width;
+  }
+  // A vertex whose faces fold back on it, or whose normals cancel, peaks without bound.
+  geometry.vertexSlopes.assign(geometry.vertices.size(), 0);
+  for (std::size_t t = 0; t < geometry.faceNormals.size(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const Index v = geometry.indices[3 * t + k];
+      const Real cosine = geometry.vertexNormals[v].dot(geometry.faceNormals[t]);
+      const Real slope = cosine > 1e-3 ? std::sqrt(std::max<Real>(0, 1 - cosine * cosine)) / cosine
+                                       : infinity;
+      geometry.vertexSlopes[v] = std::max(geometry.vertexSlopes[v], slope);
+    }
+  }
 }
 
 void TriangleMeshShape::worldVertices(std::span<Vec3> vertices) const {
@@ -236,6 +296,24 @@ std::optional<ShapeContact> TriangleMeshShape::queryPointWithin(const Vec3& poin
   if (triangle == kInvalidIndex) return std::nullopt;
   const ShapeContact contact = contactWith(local, triangle);
   if (!(std::abs(contact.distance) < maxDistance)) return std::nullopt;
+  return contact;
+}
+
+std::optional<ShapeContact> TriangleMeshShape::queryPointBelow(const Vec3& point,
+                                                               Real maxDistance) const {
+  const Vec3 local = m_motion.pose.toLocal(point);
+  // The search reaches a little past maxDistance, so that the distance compared is always
+  // contactWith()'s, as queryPoint() reports it, not the search's squared one.
+  const Real reach = maxDistance * (1 + 1e-9);
+  Index triangle = closestTriangle(local, reach * reach);
+  // Nothing that near: outside by at least maxDistance, or deep inside a closed mesh (only in
+  // its box).
+  if (triangle == kInvalidIndex) {
+    if (!m_geometry->closed || !m_geometry->bvh.bounds().contains(local)) return std::nullopt;
+    triangle = closestTriangle(local, std::numeric_limits<Real>::infinity());
+  }
+  const ShapeContact contact = contactWith(local, triangle);
+  if (!(contact.distance < maxDistance)) return std::nullopt;
   return contact;
 }
 

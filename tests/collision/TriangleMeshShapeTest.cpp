@@ -1,6 +1,7 @@
 // Triangle-mesh collider: a closed cube mesh must agree with the analytic Box everywhere (sign
 // from pseudo-normals at faces, edges and corners); an open mesh (a one-quad table top) is a
-// two-sided shell; the bounded query and the segment crossing; validation; kinematic pose.
+// two-sided shell; the bounded queries and the segment crossing; how far the surface bulges
+// round each edge; validation; kinematic pose.
 #include <weft/collision/Box.h>
 #include <weft/collision/TriangleMeshShape.h>
 
@@ -145,6 +146,120 @@ TEST(TriangleMeshShape, TheBoundedQueryAgreesWithinItsRangeAndPrunesBeyond) {
   }
   EXPECT_GT(within, 100);
   EXPECT_GT(beyond, 100);
+}
+
+TEST(TriangleMeshShape, TheQueryBelowADistanceFindsEveryPointInsideOrNearerAndNoOther) {
+  const CubeMesh cube = makeCube(Vec3(0.5, 0.4, 0.3));
+  const TriangleMeshShape mesh = TriangleMeshShape::create(cube.vertices, cube.indices).value();
+  std::mt19937 random(11);
+  std::uniform_real_distribution<Real> coordinate(-0.8, 0.8);
+  int deepInside = 0, near = 0, beyond = 0;
+  for (int trial = 0; trial < 4000; ++trial) {
+    const Vec3 point(coordinate(random), coordinate(random), coordinate(random));
+    const ShapeContact exact = mesh.queryPoint(point);
+    const std::optional<ShapeContact> below = mesh.queryPointBelow(point, 0.1);
+    if (exact.distance < 0.1) {
+      ASSERT_TRUE(below.has_value()) << "trial " << trial;
+      EXPECT_EQ(below->distance, exact.distance);
+      EXPECT_EQ(below->normal, exact.normal);
+      deepInside += exact.distance <= -0.1;  // beyond the pruned search: found through the box
+      near += std::abs(exact.distance) < 0.1;
+    } else {
+      EXPECT_FALSE(below.has_value()) << "trial " << trial;
+      ++beyond;
+    }
+  }
+  EXPECT_GT(deepInside, 10);
+  EXPECT_GT(near, 100);
+  EXPECT_GT(beyond, 100);
+}
+
+// A closed cylinder along y: `segments` round, one band of quads, a fan on each cap.
+CubeMesh makeCylinder(Real radius, Real halfHeight, Index segments) {
+  CubeMesh cylinder;
+  for (Real y : {-halfHeight, halfHeight}) {
+    for (Index k = 0; k < segments; ++k) {
+      const Real azimuth = 2 * M_PI * Real(k) / Real(segments);
+      cylinder.vertices.emplace_back(radius * std::cos(azimuth), y, -radius * std::sin(azimuth));
+    }
+  }
+  const Index bottom = Index(cylinder.vertices.size());
+  cylinder.vertices.emplace_back(0, -halfHeight, 0);
+  cylinder.vertices.emplace_back(0, halfHeight, 0);
+  const Index top = bottom + 1;
+  for (Index k = 0; k < segments; ++k) {
+    const Index next = (k + 1) % segments;
+    cylinder.indices.insert(cylinder.indices.end(), {k, next, segments + next, k,
+                                                     segments + next, segments + k});
+    cylinder.indices.insert(cylinder.indices.end(),
+                            {top, segments + k, segments + next, bottom, next, k});
+  }
+  return cylinder;
+}
+
+TEST(TriangleMeshShape, EdgesKnowHowFarTheSurfaceBulgesIntoAFaceOverThem) {
+  // A cube: its twelve edges turn a right angle (slope tan 45° = 1), the diagonals of its faces
+  // not at all; a corner's faces stand 54.7° off its normal (slope √2).
+  const CubeMesh cube = makeCube(Vec3(0.5, 0.5, 0.5));
+  const TriangleMeshShape box = TriangleMeshShape::create(cube.vertices, cube.indices).value();
+  ASSERT_EQ(box.edges().size(), 18u);
+  int sharp = 0, flat = 0;
+  for (const MeshEdge& edge : box.edges()) {
+    EXPECT_LT(edge.a, edge.b);
+    if (std::abs(edge.ridgeSlope - 1) < 1e-12) {
+      ++sharp;
+      EXPECT_NEAR(edge.bulge(0.1), 0.05, 1e-12);  // a ridge: span / 2 · slope
+    } else if (edge.ridgeSlope < 1e-12) {
+      ++flat;
+      EXPECT_EQ(edge.bulge(10), 0);
+    }
+  }
+  EXPECT_EQ(sharp, 12);
+  EXPECT_EQ(flat, 6);
+  for (Index v = 0; v < 8; ++v) EXPECT_NEAR(box.vertexSlope(v), std::sqrt(2.0), 1e-12);
+  for (Index t = 0; t < box.triangleCount(); ++t) {
+    for (int k = 0; k < 3; ++k) {
+      const MeshEdge& edge = box.edges()[box.triangleEdges(t)[k]];
+      const Index a = cube.indices[3 * t + k], b = cube.indices[3 * t + (k + 1) % 3];
+      EXPECT_EQ(edge.a, std::min(a, b));
+      EXPECT_EQ(edge.b, std::max(a, b));
+    }
+  }
+
+  // A fine cylinder of radius R: each side edge turns 2π/n, over triangles 2πR/n wide, so its
+  // curvature is about 1/(2R) (a circle's sag span²/(8R) = span² · curvature / 4); the rims
+  // are right angles.
+  const Real radius = 0.02;
+  const Index n = 256;
+  const CubeMesh rod = makeCylinder(radius, 0.5, n);
+  const TriangleMeshShape fine = TriangleMeshShape::create(rod.vertices, rod.indices).value();
+  int sides = 0;
+  for (const MeshEdge& edge : fine.edges()) {
+    const bool side = edge.a < n && edge.b == edge.a + n;  // the vertical edges
+    if (!side) continue;
+    ++sides;
+    EXPECT_NEAR(edge.ridgeSlope, std::tan(M_PI / Real(n)), 1e-9);
+    EXPECT_NEAR(edge.curvature, 1 / (2 * radius), 0.001 / radius);
+    // A 5 cm face across the rod: the ridge alone says 0.3 mm, the curvature 16 mm.
+    EXPECT_LT(edge.ridgeSlope * 0.05 / 2, 0.0004);
+    EXPECT_GT(edge.bulge(0.05), 0.015);
+  }
+  EXPECT_EQ(sides, int(n));
+
+  // An open quad: its border is a fin of one triangle (infinite), its diagonal flat.
+  const CubeMesh top = makeTableTop(0.5, 0);
+  const TriangleMeshShape quad = TriangleMeshShape::create(top.vertices, top.indices).value();
+  int borders = 0;
+  for (const MeshEdge& edge : quad.edges()) {
+    if (std::isinf(edge.ridgeSlope)) {
+      ++borders;
+      EXPECT_TRUE(std::isinf(edge.bulge(1e-6)));
+    } else {
+      EXPECT_EQ(edge.bulge(1), 0);
+    }
+  }
+  EXPECT_EQ(borders, 4);
+  for (Index v = 0; v < 4; ++v) EXPECT_EQ(quad.vertexSlope(v), 0);
 }
 
 TEST(TriangleMeshShape, TheFirstCrossingOfASegment) {

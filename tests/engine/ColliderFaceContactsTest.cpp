@@ -1,8 +1,8 @@
 // Cloth faces against bodies thinner than the triangles (face contacts, engine/src/contact/
-// FaceCores.h): a sheet dropped on a rod, a plank or a mesh plank hangs on it, where with vertex
-// contacts alone the body passes between the vertices and the sheet falls through; a towel resting
-// on a rod by its faces stays on it without riding along it. The kernels are tested in
-// ContactProjectorTest.
+// FaceCores.h): a sheet dropped on a rod, a plank, a mesh plank or a finely meshed rod hangs on
+// it, where with vertex contacts alone the body passes between the vertices and the sheet falls
+// through; a smooth mesh needs no face contacts; a towel resting on a rod by its faces stays on it
+// without riding along it. The kernels are tested in ContactProjectorTest.
 #include "ContactTestSupport.h"
 #include "contact/ContactDetector.h"
 #include "contact/ContactProjector.h"
@@ -33,7 +33,7 @@ struct RodDrop {
   Index faceContacts = 0;       // StepStats::faceContacts, summed over the frames
   Real axialDrift = 0;  // m, how far the mean vertex moved along the rod over the second half
 };
-enum class Support { Rod, Plank, MeshPlank };
+enum class Support { Rod, Plank, MeshPlank, MeshRod };
 
 // A box of `halfExtents` as a closed triangle mesh (counter-clockwise seen from outside).
 TriangleMeshShape boxMesh(const Vec3& halfExtents, const RigidMotion& pose) {
@@ -48,8 +48,33 @@ TriangleMeshShape boxMesh(const Vec3& halfExtents, const RigidMotion& pose) {
   return TriangleMeshShape::create(corners, indices, pose).value();
 }
 
+// A closed cylinder of `radius` along y, `halfHeight` each way: `segments` round, one band of
+// quads, a fan on each cap (counter-clockwise seen from outside).
+TriangleMeshShape cylinderMesh(Real radius, Real halfHeight, Index segments,
+                               const RigidMotion& pose) {
+  std::vector<Vec3> vertices;
+  std::vector<Index> indices;
+  for (Real y : {-halfHeight, halfHeight}) {
+    for (Index k = 0; k < segments; ++k) {
+      const Real azimuth = 2 * M_PI * Real(k) / Real(segments);
+      vertices.emplace_back(radius * std::cos(azimuth), y, -radius * std::sin(azimuth));
+    }
+  }
+  const Index bottom = Index(vertices.size());
+  vertices.emplace_back(0, -halfHeight, 0);
+  vertices.emplace_back(0, halfHeight, 0);
+  const Index top = bottom + 1;
+  for (Index k = 0; k < segments; ++k) {
+    const Index next = (k + 1) % segments;
+    indices.insert(indices.end(),
+                   {k, next, segments + next, k, segments + next, segments + k, top,
+                    segments + k, segments + next, bottom, next, k});
+  }
+  return TriangleMeshShape::create(vertices, indices, pose).value();
+}
+
 RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod, int threads = 1) {
-  const bool plank = support != Support::Rod;
+  const bool plank = support == Support::Plank || support == Support::MeshPlank;
   const Index n = 11;
   auto model = horizontalSquare(n, 0.5, 0.5);
   WorldSettings worldSettings;
@@ -70,6 +95,8 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
     EXPECT_TRUE(world.addCollider(Box::create(Vec3(0.01, 0.01, 0.5), plankPose).value()).ok());
   } else if (support == Support::MeshPlank) {
     EXPECT_TRUE(world.addCollider(boxMesh(Vec3(0.01, 0.01, 0.5), plankPose)).ok());
+  } else if (support == Support::MeshRod) {
+    EXPECT_TRUE(world.addCollider(cylinderMesh(kRadius, 0.5, 128, pose)).ok());
   } else {
     EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
   }
@@ -133,6 +160,76 @@ TEST(ColliderFaceContacts, ASheetHangsOnARodThinnerThanItsTriangles) {
   EXPECT_GT(vertices.deepestFace, 0.01);
 }
 
+TEST(ColliderFaceContacts, ASheetHangsOnAFinelyMeshedRodThinnerThanItsTriangles) {
+  // The rod as a mesh of 128 sides: each side edge turns 2.8°, so a face of the sheet over one
+  // edge alone would dip less than 1 mm, half the thickness; but the turns add up across the
+  // narrow sides (the rod's curvature), and the edges stay cores.
+  const RodDrop faces = dropOnRod(true, 40, Support::MeshRod);
+  EXPECT_GT(faces.middleLowest, 0.38) << "the sheet fell through the mesh rod";
+  EXPECT_GT(faces.faceContacts, 0);
+  EXPECT_LT(faces.deepestFace, 0.003 + 1e-6);
+  EXPECT_LE(faces.maxStrain, cottonFabric().strainLimit + 0.01);
+  const RodDrop vertices = dropOnRod(false, 40, Support::MeshRod);
+  EXPECT_LT(vertices.middleLowest, 0.2) << "the mesh rod no longer passes through the faces";
+}
+
+TEST(ColliderFaceContacts, AClothOnASmoothMeshNeedsNoFaceContactsAndNoFaceEntersIt) {
+  // A 0.6 m cotton square of 3 cm edges dropped on a UV sphere of radius 0.3 m (56 slices, 55
+  // stacks, 3.4 cm edges turning 3–6°): no edge bulges half the thickness into a face, so none
+  // is a core, and every face stays outside the sphere the mesh is inscribed in.
+  constexpr Real kRadius = 0.3;
+  constexpr Index kSlices = 56, kStacks = 55;
+  std::vector<Vec3> vertices{Vec3(0, kRadius, 0)};
+  for (Index stack = 1; stack < kStacks; ++stack) {
+    const Real polar = M_PI * Real(stack) / Real(kStacks);
+    for (Index slice = 0; slice < kSlices; ++slice) {
+      const Real azimuth = 2 * M_PI * Real(slice) / Real(kSlices);
+      vertices.emplace_back(kRadius * std::sin(polar) * std::cos(azimuth),
+                            kRadius * std::cos(polar),
+                            -kRadius * std::sin(polar) * std::sin(azimuth));
+    }
+  }
+  vertices.emplace_back(0, -kRadius, 0);
+  const Index south = Index(vertices.size() - 1);
+  const auto ring = [&](Index stack, Index slice) {
+    return 1 + (stack - 1) * kSlices + slice % kSlices;
+  };
+  std::vector<Index> indices;
+  for (Index slice = 0; slice < kSlices; ++slice) {
+    indices.insert(indices.end(), {0, ring(1, slice), ring(1, slice + 1)});
+    for (Index stack = 1; stack + 1 < kStacks; ++stack) {
+      indices.insert(indices.end(), {ring(stack, slice), ring(stack + 1, slice),
+                                     ring(stack + 1, slice + 1), ring(stack, slice),
+                                     ring(stack + 1, slice + 1), ring(stack, slice + 1)});
+    }
+    indices.insert(indices.end(), {south, ring(kStacks - 1, slice + 1), ring(kStacks - 1, slice)});
+  }
+  const TriangleMeshShape ball = TriangleMeshShape::create(vertices, indices).value();
+  ASSERT_TRUE(ball.isClosed());
+  World world;
+  ASSERT_TRUE(world.addCollider(ball).ok());
+  ClothSettings settings;
+  settings.material = cottonFabric();
+  const auto model = horizontalSquare(21, 0.6, 0.4);
+  const ClothId cloth = world.createCloth(model, settings).value();
+  Index faceContacts = 0, touching = 0;
+  Real nearest = std::numeric_limits<Real>::infinity();
+  for (int frame = 0; frame < 60; ++frame) {
+    world.step(1.0 / 60);
+    faceContacts += world.stats().faceContacts;
+    touching = std::max(touching, world.stats().contacts);
+    const std::span<const Vec3> x = world.positions(cloth).value();
+    for (const TriangleRest& t : model->triangles()) {
+      nearest = std::min(nearest, closestPointOnTriangle(Vec3::Zero(), x[t.vertices[0]],
+                                                         x[t.vertices[1]], x[t.vertices[2]])
+                                      .distance);
+    }
+  }
+  EXPECT_GT(touching, 50) << "the cloth did not come to rest on the mesh";
+  EXPECT_EQ(faceContacts, 0) << "a smooth region's edges were made cores";
+  EXPECT_GT(nearest, kRadius) << "a face went inside the sphere the mesh is inscribed in";
+}
+
 TEST(ColliderFaceContacts, ASheetHangsOnAPlankThinnerThanItsTriangles) {
   // A box 2 cm square in section, and the same plank as a triangle mesh (its cores are the edges
   // of its triangles near each face): edges have no radius, so a face is in contact when one
@@ -164,7 +261,7 @@ TEST(ColliderFaceContacts, ATowelRestingOnARodByItsFacesStaysOnItWithoutRidingAl
 }
 
 TEST(ColliderFaceContacts, AreBitwiseTheSameOnOneAndTwoThreads) {
-  for (Support support : {Support::Rod, Support::Plank, Support::MeshPlank}) {
+  for (Support support : {Support::Rod, Support::Plank, Support::MeshPlank, Support::MeshRod}) {
     EXPECT_EQ(dropOnRod(true, 40, support, 1).stateHash, dropOnRod(true, 40, support, 2).stateHash)
         << "support " << int(support);
   }

@@ -46,7 +46,12 @@ std::optional<PathContact> trace(const Shape& shape, const PointAt& pointAt, Rea
   Real s = 0;
   for (int step = 0; step < kMaxSteps; ++step) {
     const Vec3 point = s == 0 ? a : pointAt(s);
-    const ShapeContact contact = step == 0 ? *start : queryPoint(shape, point);
+    // A point farther from the surface than the rest of the path is long plus the thickness:
+    // the path stays clear (this bound lets a mesh prune its search).
+    const std::optional<ShapeContact> near =
+        step == 0 ? start : queryPointWithin(shape, point, speed * (1 - s) + thickness);
+    if (!near) return std::nullopt;
+    const ShapeContact& contact = *near;
     if (contact.distance < level || step + 1 == kMaxSteps) {
       return PathContact{s, point, contact.normal, contact.distance, contact.normal};
     }
@@ -57,8 +62,8 @@ std::optional<PathContact> trace(const Shape& shape, const PointAt& pointAt, Rea
     }
     s += std::max(safeStep, minimumStep) / speed;
     if (s > 1) {
-      const ShapeContact end = queryPoint(shape, b);
-      if (end.distance < level) return PathContact{1, b, end.normal, end.distance, end.normal};
+      const std::optional<ShapeContact> end = queryPointBelow(shape, b, level);
+      if (end) return PathContact{1, b, end->normal, end->distance, end->normal};
       return std::nullopt;
     }
   }
@@ -85,8 +90,9 @@ Vec3 slideOn(const Shape& shape, std::optional<PathContact> hit, const Vec3& end
     x = hit->point + remaining;
     hit = firstContact(shape, hit->point, x, thickness);
   }
-  const ShapeContact contact = queryPoint(shape, x);
-  if (contact.distance < thickness) x += (thickness - contact.distance) * contact.normal;
+  if (const std::optional<ShapeContact> contact = queryPointBelow(shape, x, thickness)) {
+    x += (thickness - contact->distance) * contact->normal;
+  }
   return x;
 }
 
@@ -202,8 +208,9 @@ Vec3 keepOutside(const ColliderFrame& collider, const Vec3& start, const Vec3& e
     s0 = s;
     hit = traceTurning(collider, from, s0, x, thickness);
   }
-  const ShapeContact contact = queryPoint(collider.shape, x);
-  if (contact.distance < thickness) x += (thickness - contact.distance) * contact.normal;
+  if (const std::optional<ShapeContact> contact = queryPointBelow(collider.shape, x, thickness)) {
+    x += (thickness - contact->distance) * contact->normal;
+  }
   return x;
 }
 

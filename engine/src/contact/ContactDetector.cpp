@@ -100,13 +100,23 @@ void ContactDetector::constrain(const ContactSpace& space,
       Index touched = kInvalidIndex;
       for (Index k : m_near) {
         const ColliderFrame& collider = colliders[k];
-        const ShapeContact contact = queryPoint(collider.shape, predicted);
-        Vec3 direction = contact.normal;
-        Real depth = contact.distance;
+        Vec3 direction = Vec3::Zero();
+        Real depth = 0;
         // Where the predicted motion relative to the body first meets it gives the face to stop
         // on: the end pose alone would push a vertex a fast body overran out through its far side.
-        if (const std::optional<PathContact> hit =
-                firstContactAlong(collider, space.startX[i], predicted, thickness)) {
+        const std::optional<PathContact> hit =
+            firstContactAlong(collider, space.startX[i], predicted, thickness);
+        if (!hit) {
+          // Only an end deeper than the deepest so far counts.
+          const std::optional<ShapeContact> below =
+              queryPointBelow(collider.shape, predicted, deepest);
+          if (!below) continue;
+          direction = below->normal;
+          depth = below->distance;
+        } else {
+          const ShapeContact contact = queryPoint(collider.shape, predicted);
+          direction = contact.normal;
+          depth = contact.distance;
           // A path that stays outside after it comes near is a graze: the end's own distance
           // holds. Extrapolating the hit's tangent plane would overshoot on a curved body. A
           // two-sided shell (an open mesh) has no inside to show the middle in: there the path
@@ -191,22 +201,25 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
     for (Index k : m_near) {
       const ColliderFrame& collider = colliders[k];
       const Vec3 start = collider.carry(space.startX[i]);
-      const ShapeContact end = queryPoint(collider.shape, space.x[i]);
-      const std::optional<PathContact> hit =
-          end.distance < thickness + margin
-              ? std::nullopt
-              : firstContactAlong(collider, space.startX[i], space.x[i], thickness);
-      if (!(end.distance < thickness + margin) && !hit) continue;
+      // An end within the margin is a contact; one beyond it, only where the path hit the body.
+      std::optional<ShapeContact> end =
+          queryPointBelow(collider.shape, space.x[i], thickness + margin);
+      std::optional<PathContact> hit;
+      if (!end) {
+        hit = firstContactAlong(collider, space.startX[i], space.x[i], thickness);
+        if (!hit) continue;
+        end = queryPoint(collider.shape, space.x[i]);
+      }
       Contact contact;
       contact.kind = ContactKind::VertexCollider;
       contact.vertices[0] = i;
-      contact.normal = hit ? hit->normal : end.normal;
+      contact.normal = hit ? hit->normal : end->normal;
       contact.separation = thickness;
-      contact.gap = end.distance;
+      contact.gap = end->distance;
       contact.friction = std::sqrt(std::max<Real>(0, collider.friction) * friction);
       contact.collider = k;
       contact.resting =
-          queryPoint(collider.shape, start).distance < (1 + kPressedShell) * thickness;
+          queryPointBelow(collider.shape, start, (1 + kPressedShell) * thickness).has_value();
       if (!solveImpulses.empty() && constrainedCollider[i] == k) {
         contact.solveImpulse = std::max<Real>(0, solveImpulses[i]);
       }
@@ -277,7 +290,14 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
       if (mesh) {
         Aabb near = path;
         near.inflate(0.5 * allowance);
-        appendMeshCores(*mesh, near, allowance, m_bodyCores, m_meshTriangles, m_meshEdges);
+        // The face's extent: its longest edge at the start or the end.
+        Real span = 0;
+        for (int j = 0; j < 3; ++j) {
+          const Index from = corner[j], to = corner[(j + 1) % 3];
+          span = std::max({span, (space.startX[to] - space.startX[from]).norm(),
+                           (space.x[to] - space.x[from]).norm()});
+        }
+        appendMeshCores(*mesh, near, allowance, span, m_bodyCores, m_meshTriangles, m_meshEdges);
       }
       for (const FaceCore& core : m_bodyCores) {
         if (!core.box.overlaps(path)) continue;

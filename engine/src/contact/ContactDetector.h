@@ -120,7 +120,7 @@ class ContactDetector {
   std::vector<Index> m_near;  // colliders near the cloth this pass
   OrderedPairFilter<Contact> m_pairFilter;
   std::vector<Index> m_meshTriangles;
-  std::vector<std::pair<Index, Index>> m_meshEdges;
+  std::vector<Index> m_meshEdges;
   std::vector<FaceCore> m_bodyCores;
   Vec3Array m_predicted;            // x₀ + h v₀, constrain()
   std::vector<char> m_constrained;  // per vertex: constrained by constrain() already

@@ -13,6 +13,13 @@ namespace {
 // core) is pushed along its own normal: one nearly across the core, which pierces it.
 constexpr Real kLeastAcross = 0.5;
 
+// A mesh edge is a core of reach kMeshEdgeReach · allowance where a face could reach it between
+// its corners: where the surface round it bulges more than kMeshEdgeClearance · allowance into
+// a face of the face's extent. Elsewhere a face whose corners keep the allowance stays twice the
+// reach from the edge, so the vertex contacts may fall short by a quarter of it.
+constexpr Real kMeshEdgeReach = 0.25;
+constexpr Real kMeshEdgeClearance = 0.5;
+
 }  // namespace
 
 // A core from `start` to `end` kept `reach` away from, with its box.
@@ -255,22 +262,38 @@ bool faceClearOfCore(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, 
   return (start > clear && end > clear) || (start < -clear && end < -clear);
 }
 
-void appendMeshCores(const TriangleMeshShape& mesh, const Aabb& near, Real allowance,
+void appendMeshCores(const TriangleMeshShape& mesh, const Aabb& near, Real allowance, Real span,
                      std::vector<FaceCore>& cores, std::vector<Index>& triangleScratch,
-                     std::vector<std::pair<Index, Index>>& edgeScratch) {
+                     std::vector<Index>& edgeScratch) {
   mesh.localBvh().queryBox(near, triangleScratch);
+  // The edges and vertices that bulge into the face, each once (most of a smooth mesh's none).
+  const Real clearance = kMeshEdgeClearance * allowance;
   edgeScratch.clear();
   for (Index meshTriangle : triangleScratch) {
-    for (int j = 0; j < 3; ++j) {
-      const Index a = mesh.indices()[3 * meshTriangle + j];
-      const Index b = mesh.indices()[3 * meshTriangle + (j + 1) % 3];
-      edgeScratch.push_back({std::min(a, b), std::max(a, b)});
+    for (Index edge : mesh.triangleEdges(meshTriangle)) {
+      if (mesh.edges()[edge].bulge(span) > clearance) edgeScratch.push_back(edge);
     }
   }
-  std::sort(edgeScratch.begin(), edgeScratch.end());
-  edgeScratch.erase(std::unique(edgeScratch.begin(), edgeScratch.end()), edgeScratch.end());
-  for (const auto& [a, b] : edgeScratch) {
-    cores.push_back(makeCore(mesh.localVertices()[a], mesh.localVertices()[b], 0.5 * allowance));
+  const std::size_t edgeCount = edgeScratch.size();
+  for (Index meshTriangle : triangleScratch) {
+    for (int k = 0; k < 3; ++k) {
+      const Index v = mesh.indices()[3 * meshTriangle + k];
+      if (mesh.vertexSlope(v) * span / 2 > clearance) edgeScratch.push_back(v);
+    }
+  }
+  const auto edgesEnd = edgeScratch.begin() + std::ptrdiff_t(edgeCount);
+  std::sort(edgeScratch.begin(), edgesEnd);
+  std::sort(edgesEnd, edgeScratch.end());
+  const Real reach = kMeshEdgeReach * allowance;
+  const std::vector<Vec3>& x = mesh.localVertices();
+  for (auto e = edgeScratch.begin(); e != edgesEnd; ++e) {
+    if (e != edgeScratch.begin() && *e == *(e - 1)) continue;
+    const MeshEdge& edge = mesh.edges()[*e];
+    cores.push_back(makeCore(x[edge.a], x[edge.b], reach));
+  }
+  for (auto v = edgesEnd; v != edgeScratch.end(); ++v) {
+    if (v != edgesEnd && *v == *(v - 1)) continue;
+    cores.push_back(makeCore(x[*v], x[*v], reach));  // a vertex that peaks, as a point
   }
 }
 

@@ -3,12 +3,21 @@
 //
 // Each body is reduced to cores, segments in its own frame that faces keep a reach away from: a
 // sphere's centre (a segment of length 0) and a capsule's axis, reach = radius − allowance (at
-// least allowance / 2, for a body thinner than that); a box's twelve edges and a mesh's edges near
-// the face, reach = allowance / 2 (a flat face of a body cannot pass between the vertices, its
-// edges can). The allowance is the contact thickness: the vertices keep it outside, and a coarse
-// mesh over a curved body sags between them by l² / (8 R), so a round body's core stays that far
-// inside, and ordinary draping makes no face contact at all. Half of it for box edges keeps a face
-// on its side of an edge it bends round, with room to tell the side at the next substep.
+// least allowance / 2, for a body thinner than that); a box's twelve edges, reach = allowance / 2
+// (a flat face of a body cannot pass between the vertices, its edges can). The allowance is the
+// contact thickness: the vertices keep it outside, and a coarse mesh over a curved body sags
+// between them by l² / (8 R), so a round body's core stays that far inside, and ordinary draping
+// makes no face contact at all. Half of it for box edges keeps a face on its side of an edge it
+// bends round, with room to tell the side at the next substep.
+//
+// A mesh's cores are the edges near the face where the surface bulges more than allowance / 2
+// into a face of its extent (MeshEdge::bulge: a ridge's turn, or turns adding up over narrow
+// triangles as a curve's sag), and the vertices that peak that much, reach = allowance / 4. Over
+// the others a face whose corners keep the allowance stays twice that reach away, so a smooth
+// region (a character's torso, a finely meshed ball) makes no face contacts, while a rod, a
+// crease or a fingertip thinner than the face does. Rejected: every edge near the face (tens of
+// contacts per face on a fine mesh, each tested every projection sweep), a fixed angle threshold
+// (a rod of many narrow sides turns little at each edge).
 //
 // Contact points of a face and a core (facePoints), in the body's frame: over the face's interior,
 // the part of the core inside the triangle's prism is a line whose height over the face is
@@ -53,10 +62,11 @@ FaceCore makeCore(const Vec3& start, const Vec3& end, Real reach);
 void appendCores(const Shape& shape, Real allowance, std::vector<FaceCore>& cores);
 
 /// Appends the edges of `mesh` whose triangles' boxes meet `near` (body frame), each once, as
-/// cores of reach allowance / 2. `scratch` is reused working memory.
-void appendMeshCores(const TriangleMeshShape& mesh, const Aabb& near, Real allowance,
+/// cores of reach allowance / 4, but only those where the surface bulges more than allowance / 2
+/// into a face of extent `span` (m; MeshEdge::bulge). `scratch` is reused working memory.
+void appendMeshCores(const TriangleMeshShape& mesh, const Aabb& near, Real allowance, Real span,
                      std::vector<FaceCore>& cores, std::vector<Index>& triangleScratch,
-                     std::vector<std::pair<Index, Index>>& edgeScratch);
+                     std::vector<Index>& edgeScratch);
 
 /// A point where a face meets a core, in the body's frame: the face point (barycentric weights),
 /// the unit normal from the core to the face, the core point, and how far the face point must

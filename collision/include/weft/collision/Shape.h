@@ -39,6 +39,19 @@ inline std::optional<ShapeContact> queryPointWithin(const Shape& shape, const Ve
   return contact;
 }
 
+/// queryPoint() for a point whose signed distance from `shape` is below `maxDistance` (m): inside
+/// the body or nearer than that; none for a point at least that far outside. A mesh prunes its
+/// search to that distance, and searches further only for a point inside its box.
+inline std::optional<ShapeContact> queryPointBelow(const Shape& shape, const Vec3& point,
+                                                   Real maxDistance) {
+  if (const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&shape)) {
+    return mesh->queryPointBelow(point, maxDistance);
+  }
+  const ShapeContact contact = queryPoint(shape, point);
+  if (!(contact.distance < maxDistance)) return std::nullopt;
+  return contact;
+}
+
 /// True when `shape` is a two-sided shell (an open TriangleMeshShape), whose unsigned distance
 /// does not change sign where a path goes through it.
 inline bool isTwoSided(const Shape& shape) {

@@ -25,6 +25,15 @@
 // is caught by the continuous tests of the caller (sphere tracing on the unsigned distance meets
 // the surface before it can pass it).
 //
+// Edges (edges()) carry how far the surface round them can bulge into a flat face that spans
+// them, from the turn of the surface there and the width of the triangles beside it: a face whose
+// corners keep a distance d from the surface keeps d − bulge(span) from the edge. A ridge turning
+// by φ rises (span / 2)·tan(φ / 2) into a face over it; turns spread over narrow triangles add up
+// as a curved surface's sag, span² · curvature / 4 (span²/(8R) for radius R). Vertices count
+// apart: a cone's tip, whose edges each turn little, rises (span / 2)·vertexSlope(v) into a face
+// over it. Cloth face contacts use both to skip the edges and vertices of smooth regions, which a
+// face cannot reach between its corners.
+//
 // For the cloth–mesh broad phase, build a Bvh over worldVertices() and indices() and refit it
 // every frame with the previous and current world vertices.
 #pragma once
@@ -36,12 +45,32 @@
 #include <weft/collision/RigidMotion.h>
 #include <weft/collision/ShapeContact.h>
 
+#include <algorithm>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace weft {
+
+/// An edge of a TriangleMeshShape (vertices a < b) and the shape of the surface at it.
+struct MeshEdge {
+  Index a = 0;  ///< the lower vertex index
+  Index b = 0;  ///< the higher vertex index
+  /// tan of half the surface's turn at the edge (the angle between its face normals; convex
+  /// turns only on a closed mesh). Infinite on a border or a fin (not two triangles).
+  Real ridgeSlope = 0;
+  /// 1/m, ridgeSlope per width of the triangles beside the edge: the curvature it stands for.
+  Real curvature = 0;
+
+  /// m, the most a flat face of extent `span` (m) over the edge comes nearer the edge than its
+  /// corners keep from the surface (see the design note).
+  Real bulge(Real span) const {
+    return std::max(ridgeSlope * span / 2, curvature * span * span / 4);
+  }
+};
 
 /// A rigid triangle mesh collider (vertices in the body frame, moved by a kinematic pose).
 class TriangleMeshShape {
@@ -60,6 +89,15 @@ class TriangleMeshShape {
   const std::vector<Index>& indices() const { return m_geometry->indices; }
   /// Number of triangles.
   Index triangleCount() const { return static_cast<Index>(m_geometry->indices.size() / 3); }
+  /// Every edge once, sorted by (a, b).
+  const std::vector<MeshEdge>& edges() const { return m_geometry->edges; }
+  /// The steepest of vertex v's faces against its normal, as a slope (tan of the angle; infinite
+  /// from a right angle): how sharply the surface peaks at v (see the design note).
+  Real vertexSlope(Index v) const { return m_geometry->vertexSlopes[v]; }
+  /// Indices into edges() of triangle t's edges: corner k's edge runs from corner k to k + 1.
+  std::span<const Index, 3> triangleEdges(Index t) const {
+    return std::span<const Index, 3>(m_geometry->triangleEdges.data() + 3 * std::size_t(t), 3);
+  }
   /// The tree over the body-frame triangles (zero thickness).
   const Bvh& localBvh() const { return m_geometry->bvh; }
   /// Writes the vertices at the current pose into `vertices` (size localVertices().size()).
@@ -82,6 +120,10 @@ class TriangleMeshShape {
   /// for a point at least that far from it. The search prunes everything beyond maxDistance, so
   /// a point far from the mesh costs a few box tests.
   std::optional<ShapeContact> queryPointWithin(const Vec3& point, Real maxDistance) const;
+  /// queryPoint() for a point whose signed distance is below `maxDistance` (m): inside a closed
+  /// mesh or nearer than that; none for a point at least that far outside. The search prunes
+  /// beyond maxDistance and goes further only for a point inside a closed mesh's box.
+  std::optional<ShapeContact> queryPointBelow(const Vec3& point, Real maxDistance) const;
   /// The parameter s ∈ [0, 1] of the first point where the world segment start → end meets a
   /// triangle (the mesh at its current pose); none when it misses them all. For an open mesh,
   /// whose unsigned distance cannot show that a path went through it.
@@ -101,11 +143,21 @@ class TriangleMeshShape {
     std::vector<Vec3> edgeNormals;    // per triangle corner k: edge (k, k+1), unit
     std::vector<Vec3> vertexNormals;  // per vertex, angle-weighted, unit
     std::vector<Vec3> corners;        // per triangle, its three vertices
+    std::vector<MeshEdge> edges;      // each edge once, sorted
+    std::vector<Index> triangleEdges; // per triangle corner k: its edge (k, k+1) in edges
+    std::vector<Real> vertexSlopes;   // per vertex, vertexSlope()
     bool closed = false;              // every edge has exactly two triangles
   };
   std::shared_ptr<const Geometry> m_geometry;
   RigidMotion m_motion;
 
+  // The turn of the surface at `edge` (positive convex; infinite unless two triangles share it)
+  // and the smaller height of its triangles over it; `slots` are its (key, triangle corner) slots.
+  static std::pair<Real, Real> edgeTurnAndWidth(
+      const Geometry& geometry, const MeshEdge& edge,
+      std::span<const std::pair<std::uint64_t, Index>> slots);
+  // Sets every edge's ridgeSlope and curvature (MeshEdge) from the edges' turns and widths.
+  static void setEdgeShapes(Geometry& geometry, std::span<const std::pair<Real, Real>> turnAndWidth);
   // The triangle closest to a body-frame point (the first found among equally close ones), or
   // kInvalidIndex when none is nearer than sqrt(maxSquared).
   Index closestTriangle(const Vec3& local, Real maxSquared) const;
