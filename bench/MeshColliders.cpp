@@ -226,24 +226,20 @@ int main(int argc, char** argv) {
   std::printf("weft-mesh-colliders: %d frames, %d repeat(s), %d thread(s), self-collision %s\n\n",
               frames, repeats, threads, self ? "on" : "off");
   constexpr Real kRadius = 0.3;
-  if (scenes.find("sphere") != std::string::npos) {
-    const Mesh ball = uvSphere(kRadius, 56, 55);
+  // A cloth of clothVertices² vertices on the analytic sphere and on a UV sphere of its radius.
+  const auto compareSpheres = [&](const char* scene, Index slices, Index stacks,
+                                  Index clothVertices, bool timeQueries) {
+    const Mesh ball = uvSphere(kRadius, slices, stacks);
     const Shape analytic = Sphere::create(kRadius).value();
     const Shape mesh = TriangleMeshShape::create(ball.vertices, ball.indices).value();
-    compare("sphere", "Sphere", analytic,
-            "UV sphere (" + std::to_string(ball.indices.size() / 3) + " tris)", mesh, 41, frames,
-            repeats, threads, self);
-    if (queries) queryCost(analytic, mesh, kRadius);
-  }
-  if (scenes.find("large") != std::string::npos) {
-    // The game-sized case: a 5,000-vertex garment on a 20,000-triangle body.
-    const Mesh ball = uvSphere(kRadius, 100, 100);
-    const Shape analytic = Sphere::create(kRadius).value();
-    const Shape mesh = TriangleMeshShape::create(ball.vertices, ball.indices).value();
-    compare("large", "Sphere", analytic,
-            "UV sphere (" + std::to_string(ball.indices.size() / 3) + " tris)", mesh, 71, frames,
-            repeats, threads, self);
-  }
+    compare(scene, "Sphere", analytic,
+            "UV sphere (" + std::to_string(ball.indices.size() / 3) + " tris)", mesh,
+            clothVertices, frames, repeats, threads, self);
+    if (timeQueries) queryCost(analytic, mesh, kRadius);
+  };
+  if (scenes.find("sphere") != std::string::npos) compareSpheres("sphere", 56, 55, 41, queries);
+  // A garment-sized cloth on a character-sized mesh.
+  if (scenes.find("large") != std::string::npos) compareSpheres("large", 100, 100, 71, false);
   if (scenes.find("cylinder") != std::string::npos) {
     const Mesh post = cylinder(kRadius, 2 * kRadius, 43, 2);
     const Shape analytic = Box::create(Vec3(kRadius, kRadius, kRadius)).value();
