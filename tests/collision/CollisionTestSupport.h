@@ -1,4 +1,5 @@
-// Shared fixtures of the collision tests: grid meshes, crumpling noise, brute-force references.
+// Shared fixtures of the collision tests: grid, box and cylinder meshes, crumpling noise,
+// brute-force references.
 #pragma once
 
 #include <weft/Math.h>
@@ -36,6 +37,42 @@ inline MeshArrays makeGrid(Index columns, Index rows, Real spacing) {
     }
   }
   return mesh;
+}
+
+/// A closed box [−h, h] as 12 triangles (counter-clockwise seen from outside).
+inline MeshArrays makeBox(const Vec3& h) {
+  MeshArrays box;
+  for (int corner = 0; corner < 8; ++corner) {
+    box.positions.emplace_back((corner & 4) ? h.x() : -h.x(), (corner & 2) ? h.y() : -h.y(),
+                               (corner & 1) ? h.z() : -h.z());
+  }
+  box.indices = {4, 6, 7, 4, 7, 5,  0, 1, 3, 0, 3, 2,  2, 3, 7, 2, 7, 6,
+                 0, 4, 5, 0, 5, 1,  1, 5, 7, 1, 7, 3,  0, 2, 6, 0, 6, 4};
+  return box;
+}
+
+/// A closed cylinder of `radius` along y, `halfHeight` each way: `segments` round (vertices
+/// k and segments + k on the bottom and top rings), one band of quads, a fan on each cap
+/// (counter-clockwise seen from outside).
+inline MeshArrays makeCylinder(Real radius, Real halfHeight, Index segments) {
+  MeshArrays cylinder;
+  for (Real y : {-halfHeight, halfHeight}) {
+    for (Index k = 0; k < segments; ++k) {
+      const Real azimuth = 2 * M_PI * Real(k) / Real(segments);
+      cylinder.positions.emplace_back(radius * std::cos(azimuth), y, -radius * std::sin(azimuth));
+    }
+  }
+  const Index bottom = Index(cylinder.positions.size());
+  cylinder.positions.emplace_back(0, -halfHeight, 0);
+  cylinder.positions.emplace_back(0, halfHeight, 0);
+  const Index top = bottom + 1;
+  for (Index k = 0; k < segments; ++k) {
+    const Index next = (k + 1) % segments;
+    cylinder.indices.insert(cylinder.indices.end(),
+                            {k, next, segments + next, k, segments + next, segments + k, top,
+                             segments + k, segments + next, bottom, next, k});
+  }
+  return cylinder;
 }
 
 /// Positions displaced by uniform noise in [−amplitude, amplitude]³ (deterministic per seed).

@@ -2,6 +2,8 @@
 // from pseudo-normals at faces, edges and corners); an open mesh (a one-quad table top) is a
 // two-sided shell; the bounded queries and the segment crossing; how far the surface bulges
 // round each edge; validation; kinematic pose.
+#include "collision/CollisionTestSupport.h"
+
 #include <weft/collision/Box.h>
 #include <weft/collision/TriangleMeshShape.h>
 
@@ -174,29 +176,6 @@ TEST(TriangleMeshShape, TheQueryBelowADistanceFindsEveryPointInsideOrNearerAndNo
   EXPECT_GT(beyond, 100);
 }
 
-// A closed cylinder along y: `segments` round, one band of quads, a fan on each cap.
-CubeMesh makeCylinder(Real radius, Real halfHeight, Index segments) {
-  CubeMesh cylinder;
-  for (Real y : {-halfHeight, halfHeight}) {
-    for (Index k = 0; k < segments; ++k) {
-      const Real azimuth = 2 * M_PI * Real(k) / Real(segments);
-      cylinder.vertices.emplace_back(radius * std::cos(azimuth), y, -radius * std::sin(azimuth));
-    }
-  }
-  const Index bottom = Index(cylinder.vertices.size());
-  cylinder.vertices.emplace_back(0, -halfHeight, 0);
-  cylinder.vertices.emplace_back(0, halfHeight, 0);
-  const Index top = bottom + 1;
-  for (Index k = 0; k < segments; ++k) {
-    const Index next = (k + 1) % segments;
-    cylinder.indices.insert(cylinder.indices.end(), {k, next, segments + next, k,
-                                                     segments + next, segments + k});
-    cylinder.indices.insert(cylinder.indices.end(),
-                            {top, segments + k, segments + next, bottom, next, k});
-  }
-  return cylinder;
-}
-
 TEST(TriangleMeshShape, EdgesKnowHowFarTheSurfaceBulgesIntoAFaceOverThem) {
   // A cube: its twelve edges turn a right angle (slope tan 45° = 1), the diagonals of its faces
   // not at all; a corner's faces stand 54.7° off its normal (slope √2).
@@ -231,8 +210,8 @@ TEST(TriangleMeshShape, EdgesKnowHowFarTheSurfaceBulgesIntoAFaceOverThem) {
   // are right angles.
   const Real radius = 0.02;
   const Index n = 256;
-  const CubeMesh rod = makeCylinder(radius, 0.5, n);
-  const TriangleMeshShape fine = TriangleMeshShape::create(rod.vertices, rod.indices).value();
+  const test::MeshArrays rod = test::makeCylinder(radius, 0.5, n);
+  const TriangleMeshShape fine = TriangleMeshShape::create(rod.positions, rod.indices).value();
   int sides = 0;
   for (const MeshEdge& edge : fine.edges()) {
     const bool side = edge.a < n && edge.b == edge.a + n;  // the vertical edges

@@ -4,6 +4,7 @@
 // through; a smooth mesh needs no face contacts; a towel resting on a rod by its faces stays on it
 // without riding along it. The kernels are tested in ContactProjectorTest.
 #include "ContactTestSupport.h"
+#include "collision/CollisionTestSupport.h"
 #include "contact/ContactDetector.h"
 #include "contact/ContactProjector.h"
 
@@ -35,44 +36,6 @@ struct RodDrop {
 };
 enum class Support { Rod, Plank, MeshPlank, MeshRod };
 
-// A box of `halfExtents` as a closed triangle mesh (counter-clockwise seen from outside).
-TriangleMeshShape boxMesh(const Vec3& halfExtents, const RigidMotion& pose) {
-  std::vector<Vec3> corners;
-  for (int corner = 0; corner < 8; ++corner) {
-    corners.emplace_back((corner & 4) ? halfExtents.x() : -halfExtents.x(),
-                         (corner & 2) ? halfExtents.y() : -halfExtents.y(),
-                         (corner & 1) ? halfExtents.z() : -halfExtents.z());
-  }
-  const std::vector<Index> indices = {4, 6, 7, 4, 7, 5,  0, 1, 3, 0, 3, 2,  2, 3, 7, 2, 7, 6,
-                                      0, 4, 5, 0, 5, 1,  1, 5, 7, 1, 7, 3,  0, 2, 6, 0, 6, 4};
-  return TriangleMeshShape::create(corners, indices, pose).value();
-}
-
-// A closed cylinder of `radius` along y, `halfHeight` each way: `segments` round, one band of
-// quads, a fan on each cap (counter-clockwise seen from outside).
-TriangleMeshShape cylinderMesh(Real radius, Real halfHeight, Index segments,
-                               const RigidMotion& pose) {
-  std::vector<Vec3> vertices;
-  std::vector<Index> indices;
-  for (Real y : {-halfHeight, halfHeight}) {
-    for (Index k = 0; k < segments; ++k) {
-      const Real azimuth = 2 * M_PI * Real(k) / Real(segments);
-      vertices.emplace_back(radius * std::cos(azimuth), y, -radius * std::sin(azimuth));
-    }
-  }
-  const Index bottom = Index(vertices.size());
-  vertices.emplace_back(0, -halfHeight, 0);
-  vertices.emplace_back(0, halfHeight, 0);
-  const Index top = bottom + 1;
-  for (Index k = 0; k < segments; ++k) {
-    const Index next = (k + 1) % segments;
-    indices.insert(indices.end(),
-                   {k, next, segments + next, k, segments + next, segments + k, top,
-                    segments + k, segments + next, bottom, next, k});
-  }
-  return TriangleMeshShape::create(vertices, indices, pose).value();
-}
-
 RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod, int threads = 1) {
   const bool plank = support == Support::Plank || support == Support::MeshPlank;
   const Index n = 11;
@@ -94,9 +57,18 @@ RodDrop dropOnRod(bool faceContacts, int frames, Support support = Support::Rod,
   if (support == Support::Plank) {
     EXPECT_TRUE(world.addCollider(Box::create(Vec3(0.01, 0.01, 0.5), plankPose).value()).ok());
   } else if (support == Support::MeshPlank) {
-    EXPECT_TRUE(world.addCollider(boxMesh(Vec3(0.01, 0.01, 0.5), plankPose)).ok());
+    const test::MeshArrays plankMesh = test::makeBox(Vec3(0.01, 0.01, 0.5));
+    EXPECT_TRUE(world
+                    .addCollider(TriangleMeshShape::create(plankMesh.positions,
+                                                           plankMesh.indices, plankPose)
+                                     .value())
+                    .ok());
   } else if (support == Support::MeshRod) {
-    EXPECT_TRUE(world.addCollider(cylinderMesh(kRadius, 0.5, 128, pose)).ok());
+    const test::MeshArrays rodMesh = test::makeCylinder(kRadius, 0.5, 128);
+    EXPECT_TRUE(world
+                    .addCollider(
+                        TriangleMeshShape::create(rodMesh.positions, rodMesh.indices, pose).value())
+                    .ok());
   } else {
     EXPECT_TRUE(world.addCollider(Capsule::create(kRadius, 0.5, pose).value()).ok());
   }

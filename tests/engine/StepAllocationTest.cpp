@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "HeapCounter.h"
+#include "collision/CollisionTestSupport.h"
 
 #include <malloc.h>
 
@@ -143,14 +144,8 @@ TEST(StepAllocation, AClothDrapedOverAMeshBoxAllocatesNothing) {
   // buffers once the cloth has draped over its sharp edges (in the first second the contact
   // lists still grow).
   World world;
-  std::vector<Vec3> corners;
-  for (int corner = 0; corner < 8; ++corner) {
-    corners.emplace_back((corner & 4) ? 0.1 : -0.1, (corner & 2) ? 0.1 : -0.1,
-                         (corner & 1) ? 0.1 : -0.1);
-  }
-  const std::vector<Index> indices = {4, 6, 7, 4, 7, 5,  0, 1, 3, 0, 3, 2,  2, 3, 7, 2, 7, 6,
-                                      0, 4, 5, 0, 5, 1,  1, 5, 7, 1, 7, 3,  0, 2, 6, 0, 6, 4};
-  ASSERT_TRUE(world.addCollider(TriangleMeshShape::create(corners, indices).value()).ok());
+  const test::MeshArrays box = test::makeBox(Vec3(0.1, 0.1, 0.1));
+  ASSERT_TRUE(world.addCollider(TriangleMeshShape::create(box.positions, box.indices).value()).ok());
   GridSettings grid;
   grid.columns = grid.rows = 15;
   grid.width = grid.height = 0.5;
