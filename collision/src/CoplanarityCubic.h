@@ -40,9 +40,9 @@ struct CandidateTimes {
 /// that a tangency missed by rounding (discriminant slightly negative) is still a candidate.
 void addQuadraticRootsAndVertex(Real q0, Real q1, Real q2, CandidateTimes& candidates);
 
-/// Candidate times of f = 0 on [0, 1]: every sign change (bisected to 1e-13, reported at the left
-/// end of the final bracket) and every piece end with |f| ≤ slack, where the pieces are [0, 1]
-/// cut at the roots of f′. Ascending.
+/// Candidate times of f = 0 on [0, 1]: every sign change (a time at most 1e-13 before it, never
+/// after) and every piece end with |f| ≤ slack, where the pieces are [0, 1] cut at the roots of
+/// f′. Ascending.
 CandidateTimes cubicCandidateTimes(const Cubic& f, Real slack);
 
 }  // namespace weft::detail
