@@ -238,16 +238,22 @@ void ImpactResolver::applyImpulse(const Impact& impact, Real targetNormalSpeed,
   }
 }
 
-bool ImpactResolver::usesDetectedPairs() const {
-  // The detection's feature pairs were found over x₀ → x₁ with a margin R; a swept box over
-  // x₀ → x₂ with a margin δ lies within the box of the same feature grown by the largest move d
-  // from x₁ to x₂, so every pair it would find is among them when 2d + δ ≤ R.
-  if (!m_detected.features || m_detected.endPositions.size() != m_end.size()) return false;
-  Real moved = 0;
+Index ImpactResolver::markFarMovers() {
+  // The detection's feature pairs were found over x₀ → x₁ with a margin R. A feature pair whose
+  // vertices each moved at most d from x₁ to x₂ comes within δ over x₀ → x₂ only if it came
+  // within δ + 2d over x₀ → x₁ (the paths share x₀ and part by at most d), so the detection
+  // listed it when 2d + δ ≤ R. The vertices that moved farther are marked: only the pairs with
+  // one of them need a search of their own.
+  m_farMover.assign(m_end.size(), 0);
+  const Real reach = (m_detected.margin - kSweptInflate) / 2;
+  Index far = 0;
   for (std::size_t i = 0; i < m_end.size(); ++i) {
-    moved = std::max(moved, (m_end[i] - m_detected.endPositions[i]).cwiseAbs().maxCoeff());
+    if ((m_end[i] - m_detected.endPositions[i]).cwiseAbs().maxCoeff() > reach) {
+      m_farMover[i] = 1;
+      ++far;
+    }
   }
-  return 2 * moved + kSweptInflate <= m_detected.margin;
+  return far;
 }
 
 bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
@@ -265,25 +271,46 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   }
   m_impacts.clear();
   if (!any) return false;
-  // The detection's feature pairs hold every pair this test would find while no end moved
-  // farther from the detection's ends than (margin − inflate) / 2: each swept box then lies within
-  // the detection's box of the same feature. Otherwise a search of its own over the dirty vertices.
-  const FeaturePairs* features = &m_features;
-  if (usesDetectedPairs()) {
-    features = m_detected.features;
+  // The detection's feature pairs hold every pair this test could find whose vertices stayed
+  // near the detection's ends (markFarMovers); the pairs with a vertex that moved farther get a
+  // search of their own. Without the detection's pairs, a search over the dirty vertices.
+  const FeaturePairs* reused = nullptr;
+  bool skipFarMovers = false;
+  if (m_detected.features && m_detected.endPositions.size() == m_end.size()) {
+    reused = m_detected.features;
+    if (markFarMovers() > 0) {
+      m_features.find(space, start, m_end, kSweptInflate, &m_farMover);
+      skipFarMovers = true;
+    }
   } else {
     m_features.find(space, start, m_end, kSweptInflate, &m_dirty);
   }
-  const auto& vertexTriangle = features->vertexTriangle();
-  const auto& edgeEdge = features->edgeEdge();
-  const Index vertexTriangleCount = Index(vertexTriangle.size());
-  const Index total = vertexTriangleCount + Index(edgeEdge.size());
+  // Index space: the reused vertex–triangle and edge–edge pairs, then the searched ones.
+  static const std::vector<std::array<Index, 2>> kNone;
+  const auto& reusedVertexTriangle = reused ? reused->vertexTriangle() : kNone;
+  const auto& reusedEdgeEdge = reused ? reused->edgeEdge() : kNone;
+  const bool searched = !reused || skipFarMovers;
+  const auto& searchedVertexTriangle = searched ? m_features.vertexTriangle() : kNone;
+  const auto& searchedEdgeEdge = searched ? m_features.edgeEdge() : kNone;
+  const Index reusedCount = Index(reusedVertexTriangle.size() + reusedEdgeEdge.size());
+  const Index total = reusedCount + Index(searchedVertexTriangle.size() + searchedEdgeEdge.size());
   auto test = [&](Index pair, Impact& impact) -> bool {
+    const bool fromReused = pair < reusedCount;
+    const auto& vertexTriangle = fromReused ? reusedVertexTriangle : searchedVertexTriangle;
+    const auto& edgeEdge = fromReused ? reusedEdgeEdge : searchedEdgeEdge;
+    if (!fromReused) pair -= reusedCount;
+    // A reused pair with a far mover is among the searched ones.
+    const bool skipFar = fromReused && skipFarMovers;
+    const Index vertexTriangleCount = Index(vertexTriangle.size());
     if (pair < vertexTriangleCount) {
       const auto& [vertex, triangle] = vertexTriangle[pair];
       const std::array<Index, 3>& c = space.triangles[triangle];
       // A pair without a dirty vertex tests as it did last time: negative.
       if (!m_dirty[vertex] && !m_dirty[c[0]] && !m_dirty[c[1]] && !m_dirty[c[2]]) return false;
+      if (skipFar &&
+          (m_farMover[vertex] || m_farMover[c[0]] || m_farMover[c[1]] || m_farMover[c[2]])) {
+        return false;
+      }
       // Most candidates the detection's wider margin kept end here, for a few comparisons.
       if (!featureBoxesWithin({vertex}, {c[0], c[1], c[2]}, start, m_end, kSweptInflate)) {
         return false;
@@ -311,6 +338,9 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
     const std::array<Index, 2>& p = space.edges[firstEdge];
     const std::array<Index, 2>& q = space.edges[secondEdge];
     if (!m_dirty[p[0]] && !m_dirty[p[1]] && !m_dirty[q[0]] && !m_dirty[q[1]]) return false;
+    if (skipFar && (m_farMover[p[0]] || m_farMover[p[1]] || m_farMover[q[0]] || m_farMover[q[1]])) {
+      return false;
+    }
     if (!featureBoxesWithin({p[0], p[1]}, {q[0], q[1]}, start, m_end, kSweptInflate)) return false;
     const std::optional<EdgeEdgeImpact> hit =
         sweptEdgeEdge({start[p[0]], start[p[1]]}, {m_end[p[0]], m_end[p[1]]},

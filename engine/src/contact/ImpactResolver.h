@@ -22,8 +22,9 @@
 //     the vertices still colliding keep their start positions, which cannot cross since x₀ is free
 //     of crossings. So no crossing survives a substep.
 // After every round of impulses, a corrected vertex whose path now meets a collider is put back
-// out of it, and a face an impulse moved into a core back to its reach; a vertex that ends within 1.5 thicknesses of a collider counts 1000× heavier in the
-// impulses, so the free side of a pair takes them.
+// out of it, and a face an impulse moved into a core back to its reach; a vertex that ends within
+// 1.5 thicknesses of a collider counts 1000× heavier in the impulses, so the free side of a pair
+// takes them.
 //
 // Impulses are shared among the four vertices of a pair by barycentric weight and inverse mass.
 // The exact tests run in parallel over fixed blocks and are put back in pair order; the impulses
@@ -46,7 +47,8 @@
 namespace weft {
 
 /// The feature pairs the detection found this substep, over x₀ → `endPositions` with `margin`
-/// (m): the impact stage's swept tests reuse them while the stages between moved little.
+/// (m): the impact stage's swept tests reuse them for the pairs whose vertices the stages between
+/// moved little, and search only the others.
 struct DetectedPairs {
   const FeaturePairs* features = nullptr;
   std::span<const Vec3> endPositions;
@@ -93,8 +95,9 @@ class ImpactResolver {
   void rigidifyZones(const ContactSpace& space);
   Real impulseInverseMass(Index vertex, const ContactSpace& space);
   void clampToColliders(const ContactSpace& space, Real h);
-  // Whether the detection's feature pairs hold every pair the next swept test can find.
-  bool usesDetectedPairs() const;
+  // Marks in m_farMover the vertices whose ends moved too far from the detection's for its
+  // feature pairs to hold theirs; returns how many.
+  Index markFarMovers();
   // keepOutside() for `vertex` ending at `end`: traced from where the projection left it when
   // the projection followed it as a collider contact (the body at its end pose), else over the
   // substep from x₀.
@@ -104,7 +107,7 @@ class ImpactResolver {
   TaskSystem* m_tasks = nullptr;
   bool m_skip = true;
   FeaturePairs m_features;
-  DetectedPairs m_detected;  // the detection's pairs, reused while every end stays within reach
+  DetectedPairs m_detected;  // the detection's pairs, reused for the ends that stay within reach
   std::span<const ColliderFrame> m_colliders;
   const ContactSet* m_set = nullptr;  // this substep's, for its face contacts
   std::vector<Index> m_near;                 // colliders near the cloth this substep
@@ -114,6 +117,7 @@ class ImpactResolver {
   Vec3Array m_end;                           // x₀ + h v̄
   Vec3Array m_testedEnd;                     // the ends of the last swept test
   std::vector<char> m_dirty;                 // per vertex: test its pairs again
+  std::vector<char> m_farMover;              // per vertex: its pairs are searched, not reused
   std::vector<char> m_touched;               // per vertex: v̄ changed
   Vec3Array m_projected;                     // x as the projection left it
   std::vector<char> m_tracked;               // per vertex: in a collider contact of the set
