@@ -387,7 +387,10 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
         m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
     projected.iterations += again.iterations;
     projected.edgesOverLimit = again.edgesOverLimit;
-    const ImpactReport more = m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs);
+    const ImpactReport more =
+        m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs,
+                          DetectedPairs{&m_detector.featurePairs(), m_solvedPositions,
+                                        m_detector.pairMargin()});
     impacts.impacts += more.impacts;
     impacts.impactZones += more.impactZones;
     impacts.frozenVertices = more.frozenVertices;

@@ -262,29 +262,32 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   for (Index i = 0; i < n; ++i) m_end[i] = start[i] + h * m_velocity[i];
   // Only pairs with a vertex whose end moved since the last test, or that was in one of its
   // hits, can test differently: the others would test exactly as then, negative.
-  bool any = false;
+  Index dirty = 0;
   for (Index i = 0; i < n; ++i) {
     if (m_dirty[i] || std::memcmp(&m_end[i], &m_testedEnd[i], sizeof(Vec3)) != 0) {
       m_dirty[i] = 1;
-      any = true;
+      ++dirty;
     }
   }
   m_impacts.clear();
-  if (!any) return false;
+  if (dirty == 0) return false;
   // The detection's feature pairs hold every pair this test could find whose vertices stayed
   // near the detection's ends (markFarMovers); the pairs with a vertex that moved farther get a
-  // search of their own. Without the detection's pairs, a search over the dirty vertices.
+  // search of their own. Without the detection's pairs, or when fewer vertices are dirty than
+  // moved far (the later passes), a search over the dirty vertices alone.
   const FeaturePairs* reused = nullptr;
   bool skipFarMovers = false;
   if (m_detected.features && m_detected.endPositions.size() == m_end.size()) {
-    reused = m_detected.features;
-    if (markFarMovers() > 0) {
+    const Index far = markFarMovers();
+    if (far == 0) {
+      reused = m_detected.features;
+    } else if (far < dirty) {
+      reused = m_detected.features;
       m_features.find(space, start, m_end, kSweptInflate, &m_farMover);
       skipFarMovers = true;
     }
-  } else {
-    m_features.find(space, start, m_end, kSweptInflate, &m_dirty);
   }
+  if (!reused) m_features.find(space, start, m_end, kSweptInflate, &m_dirty);
   // Index space: the reused vertex–triangle and edge–edge pairs, then the searched ones.
   static const std::vector<std::array<Index, 2>> kNone;
   const auto& reusedVertexTriangle = reused ? reused->vertexTriangle() : kNone;
