@@ -222,6 +222,14 @@ bool FeaturePairs::mayTouch(const ContactSpace& space, const Vec3Array& from, Re
                                 startB, margin);
 }
 
+bool FeaturePairs::searchesLocally(const ContactSpace& space, const std::vector<char>& dirty) {
+  Index dirtyTriangles = 0;
+  for (const std::array<Index, 3>& c : space.triangles) {
+    dirtyTriangles += (dirty[c[0]] | dirty[c[1]] | dirty[c[2]]) != 0;
+  }
+  return dirtyTriangles * kBoxQueriesPerSelfQuery <= Index(space.triangles.size());
+}
+
 void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
                                      const Vec3Array& to, Real inflate,
                                      const std::vector<char>* dirty) {

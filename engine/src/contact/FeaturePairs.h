@@ -76,6 +76,9 @@ class FeaturePairs {
   /// The feature pairs whose boxes over `from` → `to` (one side inflated by `inflate`) overlap,
   /// in triangle pairs the space allows (ContactSpace::pairsAllowed). With `dirty` (one flag per
   /// vertex), only the pairs with a dirty vertex.
+  /// Whether find() with `dirty` searches around the dirty triangles alone (few of them), rather
+  /// than querying the whole tree and keeping the pairs with a dirty vertex.
+  static bool searchesLocally(const ContactSpace& space, const std::vector<char>& dirty);
   void find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to, Real inflate,
             const std::vector<char>* dirty = nullptr);
 

@@ -273,15 +273,17 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   if (dirty == 0) return false;
   // The detection's feature pairs hold every pair this test could find whose vertices stayed
   // near the detection's ends (markFarMovers); the pairs with a vertex that moved farther get a
-  // search of their own. Without the detection's pairs, or when fewer vertices are dirty than
-  // moved far (the later passes), a search over the dirty vertices alone.
+  // search of their own, when it is a local one. Without the detection's pairs, or when fewer
+  // vertices are dirty than moved far (the later passes), or when so many moved far that their
+  // search would query the whole tree anyway, a search over the dirty vertices alone, whose
+  // list is shorter than the detection's.
   const FeaturePairs* reused = nullptr;
   bool skipFarMovers = false;
   if (m_detected.features && m_detected.endPositions.size() == m_end.size()) {
     const Index far = markFarMovers();
     if (far == 0) {
       reused = m_detected.features;
-    } else if (far < dirty) {
+    } else if (far < dirty && FeaturePairs::searchesLocally(space, m_farMover)) {
       reused = m_detected.features;
       m_features.find(space, start, m_end, kSweptInflate, &m_farMover);
       skipFarMovers = true;
