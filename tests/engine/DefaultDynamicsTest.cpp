@@ -1,6 +1,7 @@
 // The default dynamics: SolverSettings{} (its integrator, its tolerance, one substep of 1/60 s) on
 // a pendulum against the closed form and on a free drape against a converged run, with the
 // damping and the error the method's theory gives, whatever the default integrator is.
+#include "ContactTestSupport.h"
 #include "KnownEngineFailure.h"
 
 #include <weft/engine/World.h>
@@ -133,13 +134,7 @@ TEST(DefaultDynamics, AFreeSheetKeepsItsLinearMomentum) {
   // relative residual of 1e-10). A sheet with no gravity, drag, contact or self-collision, set
   // moving at about 1 m/s with zero momentum, keeps its centre of mass still to 1 µm/s.
   constexpr Index kSide = 21;
-  GridSettings grid;
-  grid.columns = grid.rows = kSide;
-  grid.width = grid.height = 1.0;
-  grid.origin = Vec3(-0.5, 0, 0.5);
-  grid.widthAxis = Vec3(1, 0, 0);
-  grid.heightAxis = Vec3(0, 0, -1);
-  const auto model = std::make_shared<const ClothModel>(ClothModel::grid(grid).value());
+  const std::shared_ptr<const ClothModel> model = test::horizontalSquare(kSide, 1.0, 0.0);
   WorldSettings worldSettings;
   worldSettings.gravity = Vec3::Zero();
   World world(worldSettings);
