@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace weft {
 namespace {
@@ -157,6 +158,28 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   report.solvedUnknowns = 3 * Index(m_correction.size());
 }
 
+void ImplicitEuler::keepMomentum(const DynamicSystem& system) {
+  // r = b − A Δv summed over the rows: the net force the PCG's residual leaves. The rows of the
+  // internal forces' Jacobians and of the contact couplings sum to zero, so Σ(A u) = Σm u for a
+  // uniform u up to air drag; adding u = Σr / Σm to every row leaves the residual no net force,
+  // and the step the momentum change of its external forces alone. A net force within the
+  // rounding of its own sum is none: a cloth at rest stays exactly at rest. Rejected for now:
+  // taking out the residual's torque too (A·rotation = M·rotation holds only at rest).
+  const BlockSparseMatrix& matrix = system.systemMatrix();
+  Vec3 netForce = Vec3::Zero();
+  Real mass = 0, scale = 0;
+  for (Index row = 0; row < Index(m_correction.size()); ++row) {
+    const Vec3 product = matrix.multiplyRow(row, m_correction);
+    netForce += m_rowRightHandSide[row] - product;
+    scale += m_rowRightHandSide[row].cwiseAbs().sum() + product.cwiseAbs().sum();
+    mass += m_rowMass[row];
+  }
+  const Real rounding = 64 * std::numeric_limits<Real>::epsilon() * scale;
+  if (!(mass > 0) || !(netForce.cwiseAbs().maxCoeff() > rounding)) return;
+  const Vec3 drift = netForce / mass;
+  for (Vec3& correction : m_correction) correction += drift;
+}
+
 void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
                          IntegratorReport& report) {
   stepWithHistory(system, x, v, t, h, ImplicitStepHistory{}, report);
@@ -248,6 +271,10 @@ void ImplicitEuler::stepWithHistory(DynamicSystem& system, Vec3Array& x, Vec3Arr
     if (removedPins) system.subtractPrescribedCoupling(m_deltaV, m_rowRightHandSide);
     gatherCouplings(system, map, removedPins, eta, /*newton=*/false);
     solve(system, report);
+    map.scatter(m_correction, m_deltaV);
+  }
+  if (system.prescribedVertices().empty() && m_filter.constrainedVertexCount() == 0) {
+    keepMomentum(system);
     map.scatter(m_correction, m_deltaV);
   }
   // The contact constraints' impulses of this solve (before any Newton correction, whose
