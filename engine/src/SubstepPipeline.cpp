@@ -373,10 +373,10 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   m_solvedPositions = m_space.x;
   ProjectionReport projected =
       m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
+  const DetectedPairs detectedPairs{&m_detector.featurePairs(), m_solvedPositions,
+                                    m_detector.pairMargin()};
   ImpactReport impacts =
-      m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs,
-                        DetectedPairs{&m_detector.featurePairs(), m_solvedPositions,
-                                      m_detector.pairMargin()});
+      m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs, detectedPairs);
   // The impact pass has the last word and may stretch edges the projection had limited (a
   // vertex held at its start while its neighbours moved): project and resolve again, a few
   // rounds at most, while an edge stays over its limit.
@@ -388,9 +388,7 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
     projected.iterations += again.iterations;
     projected.edgesOverLimit = again.edgesOverLimit;
     const ImpactReport more =
-        m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs,
-                          DetectedPairs{&m_detector.featurePairs(), m_solvedPositions,
-                                        m_detector.pairMargin()});
+        m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs, detectedPairs);
     impacts.impacts += more.impacts;
     impacts.impactZones += more.impactZones;
     impacts.frozenVertices = more.frozenVertices;

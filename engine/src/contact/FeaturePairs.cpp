@@ -17,6 +17,11 @@ constexpr TaskSystem::Index kGrainTrianglePairs = 256;
 // per dirty triangle: a box query visits a few dozen nodes, a self query every overlapping pair.
 constexpr Index kBoxQueriesPerSelfQuery = 8;
 
+// Whether `dirtyTriangles` of `triangles` are few enough for a box query each.
+bool boxQueriesPay(Index dirtyTriangles, Index triangles) {
+  return dirtyTriangles * kBoxQueriesPerSelfQuery <= triangles;
+}
+
 }  // namespace
 
 void FeaturePairs::build(const ContactSpace& space, TaskSystem* tasks) {
@@ -227,7 +232,7 @@ bool FeaturePairs::searchesLocally(const ContactSpace& space, const std::vector<
   for (const std::array<Index, 3>& c : space.triangles) {
     dirtyTriangles += (dirty[c[0]] | dirty[c[1]] | dirty[c[2]]) != 0;
   }
-  return dirtyTriangles * kBoxQueriesPerSelfQuery <= Index(space.triangles.size());
+  return boxQueriesPay(dirtyTriangles, Index(space.triangles.size()));
 }
 
 void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array& from,
@@ -266,7 +271,7 @@ void FeaturePairs::findTrianglePairs(const ContactSpace& space, const Vec3Array&
         return c.pairs->mayTouch(*c.space, *c.from, c.margin, a, b);
       },
       &context};
-  if (dirty && dirtyTriangles * kBoxQueriesPerSelfQuery <= Index(space.triangles.size())) {
+  if (dirty && boxQueriesPay(dirtyTriangles, Index(space.triangles.size()))) {
     // Each dirty triangle's own box against the tree: the pairs the self query would report
     // with it (the same leaf test), a pair of two dirty triangles taken from its lower one.
     m_trianglePairs.clear();

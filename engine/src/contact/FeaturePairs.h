@@ -73,12 +73,12 @@ class FeaturePairs {
   /// (Bvh::setRefitMargin; the pairs found do not change). Negative: refit everything.
   void setRefitMargin(Real margin) { m_bvh.setRefitMargin(margin); }
 
-  /// The feature pairs whose boxes over `from` → `to` (one side inflated by `inflate`) overlap,
-  /// in triangle pairs the space allows (ContactSpace::pairsAllowed). With `dirty` (one flag per
-  /// vertex), only the pairs with a dirty vertex.
   /// Whether find() with `dirty` searches around the dirty triangles alone (few of them), rather
   /// than querying the whole tree and keeping the pairs with a dirty vertex.
   static bool searchesLocally(const ContactSpace& space, const std::vector<char>& dirty);
+  /// The feature pairs whose boxes over `from` → `to` (one side inflated by `inflate`) overlap,
+  /// in triangle pairs the space allows (ContactSpace::pairsAllowed). With `dirty` (one flag per
+  /// vertex), only the pairs with a dirty vertex.
   void find(const ContactSpace& space, const Vec3Array& from, const Vec3Array& to, Real inflate,
             const std::vector<char>* dirty = nullptr);
 

@@ -291,31 +291,35 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
   }
   if (!reused) m_features.find(space, start, m_end, kSweptInflate, &m_dirty);
   // Index space: the reused vertex–triangle and edge–edge pairs, then the searched ones.
-  static const std::vector<std::array<Index, 2>> kNone;
-  const auto& reusedVertexTriangle = reused ? reused->vertexTriangle() : kNone;
-  const auto& reusedEdgeEdge = reused ? reused->edgeEdge() : kNone;
+  using PairList = std::span<const std::array<Index, 2>>;
+  const PairList reusedVertexTriangle = reused ? PairList(reused->vertexTriangle()) : PairList();
+  const PairList reusedEdgeEdge = reused ? PairList(reused->edgeEdge()) : PairList();
   const bool searched = !reused || skipFarMovers;
-  const auto& searchedVertexTriangle = searched ? m_features.vertexTriangle() : kNone;
-  const auto& searchedEdgeEdge = searched ? m_features.edgeEdge() : kNone;
+  const PairList searchedVertexTriangle =
+      searched ? PairList(m_features.vertexTriangle()) : PairList();
+  const PairList searchedEdgeEdge = searched ? PairList(m_features.edgeEdge()) : PairList();
   const Index reusedCount = Index(reusedVertexTriangle.size() + reusedEdgeEdge.size());
   const Index total = reusedCount + Index(searchedVertexTriangle.size() + searchedEdgeEdge.size());
+  // Whether any of a pair's four vertices carries `flag`.
+  auto anyFlagged = [](const std::vector<char>& flag, const std::array<Index, 4>& vertices) {
+    return flag[vertices[0]] || flag[vertices[1]] || flag[vertices[2]] || flag[vertices[3]];
+  };
   auto test = [&](Index pair, Impact& impact) -> bool {
     const bool fromReused = pair < reusedCount;
-    const auto& vertexTriangle = fromReused ? reusedVertexTriangle : searchedVertexTriangle;
-    const auto& edgeEdge = fromReused ? reusedEdgeEdge : searchedEdgeEdge;
+    const PairList vertexTriangle = fromReused ? reusedVertexTriangle : searchedVertexTriangle;
+    const PairList edgeEdge = fromReused ? reusedEdgeEdge : searchedEdgeEdge;
     if (!fromReused) pair -= reusedCount;
-    // A reused pair with a far mover is among the searched ones.
-    const bool skipFar = fromReused && skipFarMovers;
+    // A pair without a dirty vertex tests as it did last time: negative. A reused pair with a
+    // far mover is among the searched ones.
+    auto skipped = [&](const std::array<Index, 4>& vertices) {
+      return !anyFlagged(m_dirty, vertices) ||
+             (fromReused && skipFarMovers && anyFlagged(m_farMover, vertices));
+    };
     const Index vertexTriangleCount = Index(vertexTriangle.size());
     if (pair < vertexTriangleCount) {
       const auto& [vertex, triangle] = vertexTriangle[pair];
       const std::array<Index, 3>& c = space.triangles[triangle];
-      // A pair without a dirty vertex tests as it did last time: negative.
-      if (!m_dirty[vertex] && !m_dirty[c[0]] && !m_dirty[c[1]] && !m_dirty[c[2]]) return false;
-      if (skipFar &&
-          (m_farMover[vertex] || m_farMover[c[0]] || m_farMover[c[1]] || m_farMover[c[2]])) {
-        return false;
-      }
+      if (skipped({vertex, c[0], c[1], c[2]})) return false;
       // Most candidates the detection's wider margin kept end here, for a few comparisons.
       if (!featureBoxesWithin({vertex}, {c[0], c[1], c[2]}, start, m_end, kSweptInflate)) {
         return false;
@@ -342,10 +346,7 @@ bool ImpactResolver::findImpacts(const ContactSpace& space, Real h) {
     const auto& [firstEdge, secondEdge] = edgeEdge[pair - vertexTriangleCount];
     const std::array<Index, 2>& p = space.edges[firstEdge];
     const std::array<Index, 2>& q = space.edges[secondEdge];
-    if (!m_dirty[p[0]] && !m_dirty[p[1]] && !m_dirty[q[0]] && !m_dirty[q[1]]) return false;
-    if (skipFar && (m_farMover[p[0]] || m_farMover[p[1]] || m_farMover[q[0]] || m_farMover[q[1]])) {
-      return false;
-    }
+    if (skipped({p[0], p[1], q[0], q[1]})) return false;
     if (!featureBoxesWithin({p[0], p[1]}, {q[0], q[1]}, start, m_end, kSweptInflate)) return false;
     const std::optional<EdgeEdgeImpact> hit =
         sweptEdgeEdge({start[p[0]], start[p[1]]}, {m_end[p[0]], m_end[p[1]]},
