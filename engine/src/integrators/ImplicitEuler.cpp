@@ -158,26 +158,100 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   report.solvedUnknowns = 3 * Index(m_correction.size());
 }
 
-void ImplicitEuler::keepMomentum(const DynamicSystem& system) {
-  // r = b − A Δv summed over the rows: the net force the PCG's residual leaves. The rows of the
-  // internal forces' Jacobians and of the contact couplings sum to zero, so Σ(A u) = Σm u for a
-  // uniform u up to air drag; adding u = Σr / Σm to every row leaves the residual no net force,
-  // and the step the momentum change of its external forces alone. A net force within the
-  // rounding of its own sum is none: a cloth at rest stays exactly at rest. Rejected for now:
-  // taking out the residual's torque too (A·rotation = M·rotation holds only at rest).
+namespace {
+
+// The matrix [v]ₓ with [v]ₓ a = v × a.
+Mat3 crossMatrix(const Vec3& v) {
+  Mat3 m;
+  m << 0, -v.z(), v.y(),  //
+      v.z(), 0, -v.x(),   //
+      -v.y(), v.x(), 0;
+  return m;
+}
+
+}  // namespace
+
+void ImplicitEuler::keepMomentum(const DynamicSystem& system, const FreeVertexMap& map,
+                                 const Vec3Array& x) {
+  // The rigid motions of the cloth, Φ_i α = a + ω × r_i (r_i = x_i − c about the centre of mass
+  // c), are the directions in which internal forces neither push nor turn it. Galerkin step in
+  // their span: Δv += Φα with (Φᵀ A Φ) α = Φᵀ r, r = b − A Δv, so that the new residual has no
+  // net force and no net torque. The PCG's early stop then changes the momentum and the angular
+  // momentum no more than the exact solve does: Tᵀ A e = 0 is Tᵀ M e = 0 for a translation T (the
+  // rows of the force Jacobians and of the contact couplings sum to zero; air drag aside), and
+  // for a rotation R, Rᵀ A e = 0 leaves Rᵀ M e = h² (K R)ᵀ e, second order in the step, as
+  // damping does not resist a rigid rotation and K R_k = e_k × f (the forces turn with the
+  // cloth). A correction below the PCG's absolute floor (in the energy norm, which bounds the
+  // mass norm) is one the solve does not resolve either, and is left out: a cloth at rest stays
+  // exactly at rest. Rejected: the translation alone (u = Σr / Σm) leaves a free cloth turning
+  // from its internal forces; M instead of A in the 6×6 system (exact only at rest).
+  using Mat6 = Eigen::Matrix<Real, 6, 6>;
+  using Vec6 = Eigen::Matrix<Real, 6, 1>;
   const BlockSparseMatrix& matrix = system.systemMatrix();
-  Vec3 netForce = Vec3::Zero();
-  Real mass = 0, scale = 0;
-  for (Index row = 0; row < Index(m_correction.size()); ++row) {
-    const Vec3 product = matrix.multiplyRow(row, m_correction);
-    netForce += m_rowRightHandSide[row] - product;
-    scale += m_rowRightHandSide[row].cwiseAbs().sum() + product.cwiseAbs().sum();
+  const Index rows = Index(m_correction.size());
+  Real mass = 0;
+  Vec3 centre = Vec3::Zero();
+  for (Index row = 0; row < rows; ++row) {
     mass += m_rowMass[row];
+    centre += m_rowMass[row] * x[map.vertex(row)];
   }
-  const Real rounding = 64 * std::numeric_limits<Real>::epsilon() * scale;
-  if (!(mass > 0) || !(netForce.cwiseAbs().maxCoeff() > rounding)) return;
-  const Vec3 drift = netForce / mass;
-  for (Vec3& correction : m_correction) correction += drift;
+  if (!(mass > 0)) return;
+  centre /= mass;
+  const auto arm = [&](Index row) -> Vec3 { return x[map.vertex(row)] - centre; };
+  // Φ_iᵀ y = (y, r_i × y): a row's force and its torque about c.
+  const auto project = [](const Vec3& r, const Vec3& y) {
+    Vec6 out;
+    out << y, r.cross(y);
+    return out;
+  };
+  Mat6 reduced = Mat6::Zero();     // Φᵀ (A + E) Φ
+  Vec6 residual = Vec6::Zero();    // Φᵀ (b − (A + E) Δv)
+  for (Index row = 0; row < rows; ++row) {
+    // (A Φ)_i = [Σ_j A_ij, −Σ_j A_ij [r_j]ₓ] and (A Δv)_i in one sweep over the row.
+    Mat3 blockSum = Mat3::Zero(), turnSum = Mat3::Zero();
+    Vec3 product = Vec3::Zero();
+    for (Index slot = matrix.rowBegin(row); slot < matrix.rowEnd(row); ++slot) {
+      const Mat3& block = matrix.block(slot);
+      const Index column = matrix.column(slot);
+      blockSum += block;
+      turnSum.noalias() -= block * crossMatrix(arm(column));
+      product.noalias() += block * m_correction[column];
+    }
+    const Vec3 r = arm(row);
+    const Vec3 force = m_rowRightHandSide[row] - product;
+    residual += project(r, force);
+    Eigen::Matrix<Real, 3, 6> rowModes;
+    rowModes << blockSum, turnSum;
+    reduced.topRows<3>() += rowModes;
+    reduced.bottomRows<3>().noalias() += crossMatrix(r) * rowModes;
+  }
+  // The contact couplings' terms c JᵀJ: J Φ and J Δv per term.
+  for (const ContactCoupling& term : m_rowCouplings) {
+    Vec6 modes = Vec6::Zero();
+    Real rate = 0;
+    for (int k = 0; k < 4; ++k) {
+      const Index row = term.rows[k];
+      if (row == kInvalidIndex) continue;
+      modes += term.weights[k] * project(arm(row), term.normal);
+      rate += term.weights[k] * term.normal.dot(m_correction[row]);
+    }
+    reduced.noalias() += term.coefficient * modes * modes.transpose();
+    residual -= term.coefficient * rate * modes;
+  }
+  const Eigen::LDLT<Mat6> factor(reduced);
+  Vec6 step = factor.info() == Eigen::Success ? Vec6(factor.solve(residual)) : Vec6::Zero();
+  if (!step.allFinite() ||
+      !(factor.vectorD().minCoeff() > 1e-12 * factor.vectorD().cwiseAbs().maxCoeff())) {
+    // A degenerate cloth (a strip along one line cannot turn about it): the translation only.
+    step.setZero();
+    const Eigen::LDLT<Mat3> translation(reduced.topLeftCorner<3, 3>());
+    step.head<3>() = translation.solve(residual.head<3>());
+    if (!step.allFinite()) return;
+  }
+  const Real floor = PcgSettings{}.absoluteTolerance;
+  if (!(step.dot(reduced * step) > floor * floor)) return;
+  const Vec3 shift = step.head<3>(), turn = step.tail<3>();
+  for (Index row = 0; row < rows; ++row) m_correction[row] += shift + turn.cross(arm(row));
 }
 
 void ImplicitEuler::step(DynamicSystem& system, Vec3Array& x, Vec3Array& v, Real t, Real h,
@@ -274,7 +348,7 @@ void ImplicitEuler::stepWithHistory(DynamicSystem& system, Vec3Array& x, Vec3Arr
     map.scatter(m_correction, m_deltaV);
   }
   if (system.prescribedVertices().empty() && m_filter.constrainedVertexCount() == 0) {
-    keepMomentum(system);
+    keepMomentum(system, map, x);
     map.scatter(m_correction, m_deltaV);
   }
   // The contact constraints' impulses of this solve (before any Newton correction, whose

@@ -82,10 +82,10 @@ class ImplicitEuler final : public Integrator {
  private:
   void resizeVertices(Index vertexCount);
   void resizeRows(Index rowCount);
-  // On a cloth with no pin and no contact constraint: the uniform velocity change that takes
-  // the net force out of the PCG's residual, so an inexact solve keeps the linear momentum
-  // (internal forces change none).
-  void keepMomentum(const DynamicSystem& system);
+  // On a cloth with no pin and no contact constraint: the rigid velocity change (x the step's
+  // start positions) that takes the net force and torque out of the PCG's residual, so an
+  // inexact solve keeps the momentum and angular momentum its forces give (internal: none).
+  void keepMomentum(const DynamicSystem& system, const FreeVertexMap& map, const Vec3Array& x);
   void solve(DynamicSystem& system, IntegratorReport& report);
   // The system's active contact couplings renumbered into rows (m_rowCouplings), their forces
   // added to the row right-hand side (h (F + h K v), or h F for a Newton iteration; h is the
