@@ -53,6 +53,7 @@ void addSubstepCounters(const StepStats& from, StepStats& to) {
   to.selfImpacts += from.selfImpacts;
   to.impactZones += from.impactZones;
   to.frozenVertices += from.frozenVertices;
+  to.unresolvedContacts += from.unresolvedContacts;
   to.strainLimitIterations += from.strainLimitIterations;
   to.strainLimitEdgesOver += from.strainLimitEdgesOver;
   to.colliderNarrowPhases += from.colliderNarrowPhases;
@@ -217,6 +218,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
   }
   if (stats.squeezedVertices > 0) stats.status |= StepStatus::Squeezed;
   if (stats.frozenVertices > 0) stats.status |= StepStatus::ContactsFrozen;
+  if (stats.unresolvedContacts > 0) stats.status |= StepStatus::ContactsUnresolved;
   const bool rolledBack = hasFlag(stats.status, StepStatus::RolledBack);
 
   // The frame's end: pins, sleep, the figures of the report.
@@ -387,6 +389,7 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
         m_projector.project(m_space, m_contacts, m_colliders, h, m_projection, m_supports);
     projected.iterations += again.iterations;
     projected.edgesOverLimit = again.edgesOverLimit;
+    projected.contactsViolated = again.contactsViolated;
     const ImpactReport more =
         m_impacts.resolve(m_space, m_contacts, m_colliders, h, pairs, detectedPairs);
     impacts.impacts += more.impacts;
@@ -442,6 +445,7 @@ HealthFailure SubstepPipeline::substep(Real t, Real h, Index index, StepStats& s
   stats.selfImpacts += impacts.impacts;
   stats.impactZones += impacts.impactZones;
   stats.frozenVertices += impacts.frozenVertices;
+  stats.unresolvedContacts += projected.contactsViolated;
   stats.strainLimitIterations += projected.iterations;
   stats.strainLimitEdgesOver += projected.edgesOverLimit;
   const Bvh::RefitCounts detected = m_detector.takeRefitCounts();

@@ -34,6 +34,7 @@ std::string describe(StepStatus status) {
   add(StepStatus::StrainLimitExceeded, "strain-limit-exceeded");
   add(StepStatus::Squeezed, "squeezed");
   add(StepStatus::ContactsFrozen, "contacts-frozen");
+  add(StepStatus::ContactsUnresolved, "contacts-unresolved");
   return text;
 }
 

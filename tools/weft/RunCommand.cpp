@@ -61,7 +61,7 @@ bool parseResolution(const std::string& text, int& width, int& height) {
 // Counts of each status flag over the run.
 struct StatusCounts {
   unsigned unstable = 0, notConverged = 0, rolledBack = 0, retried = 0, invalid = 0, overLimit = 0,
-           squeezed = 0, frozen = 0;
+           squeezed = 0, frozen = 0, unresolved = 0;
   void add(StepStatus s) {
     unstable += hasFlag(s, StepStatus::Unstable);
     notConverged += hasFlag(s, StepStatus::SolverNotConverged);
@@ -71,6 +71,7 @@ struct StatusCounts {
     overLimit += hasFlag(s, StepStatus::StrainLimitExceeded);
     squeezed += hasFlag(s, StepStatus::Squeezed);
     frozen += hasFlag(s, StepStatus::ContactsFrozen);
+    unresolved += hasFlag(s, StepStatus::ContactsUnresolved);
   }
   std::string describe() const {
     std::string text;
@@ -85,6 +86,7 @@ struct StatusCounts {
     item(overLimit, "strain-limit-exceeded");
     item(squeezed, "squeezed");
     item(frozen, "contacts-frozen");
+    item(unresolved, "contacts-unresolved");
     return text.empty() ? "ok in every frame" : text;
   }
 };

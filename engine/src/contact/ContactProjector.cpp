@@ -13,6 +13,11 @@ namespace {
 // projection (its normal velocity is made inelastic): the projection leaves contacts at exactly
 // the thickness, a body's curvature a little beyond.
 constexpr Real kOnSurfaceShell = 0.01;
+// A projection stopped at its sweep cap reports the contacts it left short of their separation by
+// more than this share of their thickness (StepStatus::ContactsUnresolved): ten times the
+// tolerance it works to, so that a contact still converging in its last per cent at the cap
+// (a face on a finely meshed rod) is not reported, and one the cap cut short is.
+constexpr Real kUnresolvedShortfall = 0.1;
 // Friction acts in every sweep, its accumulated correction bounded by the contact's budget, so
 // the sweeps that satisfy the strain limit and the separations cannot undo what it holds (a
 // towel resting on a rod by its faces would creep along it).
@@ -137,6 +142,7 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
         report.edgesOverLimit +=
             length > space.longest[e] + settings.strainTolerance * space.restLengths[e];
       }
+      report.contactsViolated = unseparatedContacts(space, set, colliders, kUnresolvedShortfall);
       break;
     }
   }
@@ -146,6 +152,40 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   for (Index i = 0; i < space.vertexCount(); ++i) space.v[i] += (space.x[i] - m_solved[i]) * inverseStep;
   report.colliderContacts = finish(space, set, colliders, supports);
   return report;
+}
+
+Index ContactProjector::unseparatedContacts(const ContactSpace& space, const ContactSet& set,
+                                            std::span<const ColliderFrame> colliders,
+                                            Real shortfall) const {
+  // Separation only: a sweep's own count also holds the friction corrections still moving.
+  Index count = 0;
+  for (const Contact& contact : set.contacts) {
+    const Real slack = shortfall * space.owners[space.owner[contact.vertices[0]]].thickness;
+    switch (contact.kind) {
+      case ContactKind::VertexCollider:
+        count += queryPointBelow(colliders[contact.collider].shape, space.x[contact.vertices[0]],
+                                 contact.separation - slack)
+                     .has_value();
+        break;
+      case ContactKind::FaceCollider: {
+        const Pose& pose = colliders[contact.collider].end.pose;
+        std::array<FacePoint, 3> points;
+        count += facePoints(set.cores[contact.core], contact.normal,
+                            pose.toLocal(space.x[contact.vertices[0]]),
+                            pose.toLocal(space.x[contact.vertices[1]]),
+                            pose.toLocal(space.x[contact.vertices[2]]), slack, points) > 0;
+        break;
+      }
+      case ContactKind::VertexFace:
+      case ContactKind::EdgeEdge: {
+        Vec3 gap = Vec3::Zero();
+        for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
+        count += contact.normal.dot(gap) < contact.separation - slack;
+        break;
+      }
+    }
+  }
+  return count;
 }
 
 std::uint64_t ContactProjector::movesOf(const Contact& contact) const {

@@ -76,7 +76,9 @@ struct ProjectionSettings {
 struct ProjectionReport {
   int iterations = 0;        ///< sweeps run (0: nothing to correct)
   Index edgesOverLimit = 0;  ///< edges over limit + tolerance when it stopped
-  Index contactsViolated = 0;  ///< contacts violated beyond tolerance when it stopped
+  /// Contacts short of their separation by more than a tenth of their thickness when it stopped
+  /// at its sweep cap (0 when it converged).
+  Index contactsViolated = 0;
   Index colliderContacts = 0;  ///< vertices and faces on a collider at the end
 };
 
@@ -92,6 +94,10 @@ class ContactProjector {
   // One Gauss–Seidel sweep over the edges over their limit; returns how many were over
   // limit + tolerance before their correction.
   Index sweepEdges(ContactSpace& space, Real tolerance, bool backward);
+  // The contacts of `set` short of their separation by more than `shortfall` thicknesses,
+  // measured without correcting.
+  Index unseparatedContacts(const ContactSpace& space, const ContactSet& set,
+                            std::span<const ColliderFrame> colliders, Real shortfall) const;
   // Σ m_moves over the contact's vertices.
   std::uint64_t movesOf(const Contact& contact) const;
   // Marks edge e as seen within its limit when it is (sweepEdges skips it until an end moves).

@@ -44,6 +44,11 @@ enum class StepStatus : std::uint32_t {
   /// StepStats::frozenVertices): nothing crossed, but those vertices stopped. Take more substeps
   /// or raise the thickness if it persists.
   ContactsFrozen = 1u << 8,
+  /// The contact projection stopped at its sweep cap with contacts still short of their
+  /// separation by more than a tenth of their thickness (StepStats::unresolvedContacts): nothing
+  /// crossed (the impact pass has the last word), but those features ended the substep that much
+  /// nearer each other or a body. Take more substeps, or move pins and bodies less far per frame.
+  ContactsUnresolved = 1u << 9,
 };
 
 constexpr StepStatus operator|(StepStatus a, StepStatus b) {
@@ -102,6 +107,10 @@ struct StepStats {
   /// impact zones did not clear their contacts (all substeps): the contacts the engine did not
   /// resolve physically. They never cross; they stop instead (StepStatus::ContactsFrozen).
   Index frozenVertices = 0;
+  /// Contacts the projection left short of their separation by more than a tenth of their
+  /// thickness when it stopped at its sweep cap, summed over substeps
+  /// (StepStatus::ContactsUnresolved).
+  Index unresolvedContacts = 0;
   /// Sweeps of the contact projection (strain limits and contacts together), summed over
   /// substeps; 0 when no edge went over its limit and no contact was violated.
   int strainLimitIterations = 0;
