@@ -966,6 +966,7 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
         continue;
       }
       bool beyondNoise = false;
+      bool tiedErrors = true;  // every run that dominates it does so by its time alone
       std::ostringstream by;
       for (std::size_t j : fronts[p]) {
         if (!dominates(runs[j], defaults, p, verdicts[p])) continue;
@@ -974,9 +975,20 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
         by << "; " << describeConfig(runs[j]) << " (" << std::setprecision(3) << timeRatio
            << "x the CPU time, " << errorRatio << "x the error)";
         beyondNoise = beyondNoise || timeRatio < 1 - kTimingNoise || errorRatio < 1 - kTimingNoise;
+        tiedErrors = tiedErrors && errorRatio == 1;
       }
-      tables << (beyondNoise ? "DOMINATED beyond the noise" : "dominated only within the noise (10 %)")
-             << by.str() << "\n";
+      // Where the reference does not resolve the phase, errors under its floor tie: a run that
+      // dominates there at a tied error is only cheaper, not shown to be as accurate.
+      if (!verdicts[p].byDistance) {
+        tables << "ranked by shape statistics (reference "
+               << (verdicts[p].chaotic ? "chaotic" : "unresolved") << "): ";
+      }
+      if (!verdicts[p].byDistance && tiedErrors) {
+        tables << "cheaper runs tie with it under the floor, no difference in error measured";
+      } else {
+        tables << (beyondNoise ? "DOMINATED beyond the noise" : "dominated only within the noise (10 %)");
+      }
+      tables << by.str() << "\n";
       if (beyondNoise && verdicts[p].byDistance && options.checkDefaults) status = 3;
     }
   }
