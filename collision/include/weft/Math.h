@@ -35,4 +35,13 @@ inline constexpr Index kInvalidIndex = std::numeric_limits<Index>::max();
 /// True when every component is finite (no NaN, no infinity).
 inline bool isFinite(const Vec3& v) { return v.allFinite(); }
 
+/// The matrix [v]ₓ with [v]ₓ a = v × a.
+inline Mat3 crossMatrix(const Vec3& v) {
+  Mat3 m;
+  m << 0, -v.z(), v.y(),  //
+      v.z(), 0, -v.x(),   //
+      -v.y(), v.x(), 0;
+  return m;
+}
+
 }  // namespace weft

@@ -53,15 +53,6 @@ Vec3 acrossDirection(const Vec3& d) {
 /// treated as degenerate: θ's gradient grows like 1/height and its Hessian like 1/height².
 constexpr Real kDegenerateHingeRatio = 1e-8;
 
-/// The matrix [v]× with [v]× a = v × a.
-Mat3 crossMatrix(const Vec3& v) {
-  Mat3 m;
-  m << 0, -v.z(), v.y(),  //
-      v.z(), 0, -v.x(),   //
-      -v.y(), v.x(), 0;
-  return m;
-}
-
 /// Maps an angle difference into (−π, π], so a hinge at rest near ±π does not see a 2π jump.
 Real wrapAngle(Real angle) {
   if (angle > kPi) {

@@ -158,19 +158,6 @@ void ImplicitEuler::solve(DynamicSystem& system, IntegratorReport& report) {
   report.solvedUnknowns = 3 * Index(m_correction.size());
 }
 
-namespace {
-
-// The matrix [v]ₓ with [v]ₓ a = v × a.
-Mat3 crossMatrix(const Vec3& v) {
-  Mat3 m;
-  m << 0, -v.z(), v.y(),  //
-      v.z(), 0, -v.x(),   //
-      -v.y(), v.x(), 0;
-  return m;
-}
-
-}  // namespace
-
 void ImplicitEuler::keepMomentum(const DynamicSystem& system, const FreeVertexMap& map,
                                  const Vec3Array& x) {
   // The rigid motions of the cloth, Φ_i α = a + ω × r_i (r_i = x_i − c about the centre of mass
