@@ -438,10 +438,7 @@ void ContactDetector::detectPairs(const ContactSpace& space, ContactSet& set) {
       // to it in one substep (Bridson, Fedkiw & Anderson 2002's repulsion rate), never closer
       // than it started: folds pressed tighter than two thicknesses (a sandwiched layer) would
       // otherwise ask for positions no projection can reach.
-      Real startGap = 0;
-      Vec3 start = Vec3::Zero();
-      for (int k = 0; k < 4; ++k) start += contact.weights[k] * x0[contact.vertices[k]];
-      startGap = std::max<Real>(0, contact.normal.dot(start));
+      const Real startGap = std::max<Real>(0, contact.normal.dot(contact.relativePosition(x0)));
       if (startGap < contact.separation) {
         contact.separation = startGap + kRepulsionRate * (contact.separation - startGap);
       }

@@ -178,9 +178,7 @@ Index ContactProjector::unseparatedContacts(const ContactSpace& space, const Con
       }
       case ContactKind::VertexFace:
       case ContactKind::EdgeEdge: {
-        Vec3 gap = Vec3::Zero();
-        for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
-        count += contact.normal.dot(gap) < contact.separation - slack;
+        count += contact.normal.dot(contact.relativePosition(space.x)) < contact.separation - slack;
         break;
       }
     }
@@ -432,9 +430,7 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
                                    Real h) {
   const auto [inverseMass, weight] = m_pairMass[index];
   if (!(weight > 0)) return 0;
-  Vec3 gap = Vec3::Zero();
-  for (int k = 0; k < 4; ++k) gap += contact.weights[k] * space.x[contact.vertices[k]];
-  const Real shortfall = contact.separation - contact.normal.dot(gap);
+  const Real shortfall = contact.separation - contact.normal.dot(contact.relativePosition(space.x));
   // Moves the pair's sides relative to each other by `relativeChange`.
   const auto move = [&](const Vec3& relativeChange) {
     const Vec3 lambda = relativeChange / weight;
@@ -542,13 +538,9 @@ Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,
       // A pair in contact keeps no relative velocity into itself.
       const auto [inverseMass, weight] = m_pairMass[c];
       if (!(weight > 0)) continue;
-      Vec3 gap = Vec3::Zero(), relative = Vec3::Zero();
-      for (int k = 0; k < 4; ++k) {
-        gap += contact.weights[k] * space.x[contact.vertices[k]];
-        relative += contact.weights[k] * space.v[contact.vertices[k]];
-      }
+      const Vec3 gap = contact.relativePosition(space.x);
       if (contact.normal.dot(gap) > (1 + kOnSurfaceShell) * contact.separation) continue;
-      const Real normalSpeed = relative.dot(contact.normal);
+      const Real normalSpeed = contact.relativePosition(space.v).dot(contact.normal);
       if (!(normalSpeed < 0)) continue;
       const Real lambda = -normalSpeed / weight;
       for (int k = 0; k < 4; ++k) {

@@ -26,6 +26,7 @@
 
 #include <array>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 namespace weft {
@@ -66,6 +67,13 @@ struct Contact {
   /// True when the contact began the substep touching (within the contact shell): friction then
   /// acts on the substep's whole tangential displacement, so a resting contact does not creep.
   bool resting = false;
+
+  /// p − q at positions `x` (pairs: all four vertices are set).
+  Vec3 relativePosition(std::span<const Vec3> x) const {
+    Vec3 sum = Vec3::Zero();
+    for (int k = 0; k < 4; ++k) sum += weights[k] * x[vertices[k]];
+    return sum;
+  }
 };
 
 /// Every contact of one substep, in a deterministic order: collider contacts by vertex (then
