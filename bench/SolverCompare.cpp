@@ -1,13 +1,14 @@
-// weft-solver-compare: block-Jacobi against multicolour Gauss–Seidel PCG on the scenes that
-// decide the default (the curtain ×1 and ×4, stress scene 2's stiff sheet), in one process.
+// weft-solver-compare: block-Jacobi, multicolour Gauss–Seidel and two-level Gauss–Seidel PCG on
+// the scenes that decide the default (the curtain ×1, ×4 and ×16 on request, stress scene 2's
+// stiff sheet), in one process.
 //
 //   build/bench/weft-solver-compare [--frames 600] [--sizes 1,4] [--threads 1] [--repeats 2]
 //
-// Every run is repeated and the preconditioners alternate (J, G, J, G, …), so a machine shared
+// Every run is repeated and the preconditioners alternate (J, G, T, J, G, T, …), so a machine shared
 // with other jobs slows both alike; a frame's time is the calling thread's CPU time for
 // World::step (plus wall time, which also shows waits), the smaller of the repeats is kept. The
 // report gives, per scene: PCG iterations per solve (mean, max), solves at the cap, solve ms
-// (World's own wall-clock measure), simulation CPU ms per frame and the ratios G / J, and the
+// (World's own wall-clock measure), simulation CPU ms per frame and the ratios to Gauss–Seidel, and the
 // curtain's state hash per preconditioner (thread-count independent; compare with weft-curtain).
 #include "BenchClock.h"
 
@@ -16,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cinttypes>
 #include <cstdio>
 #include <ctime>
@@ -61,7 +63,13 @@ struct RunFigures {
 };
 
 const char* name(PreconditionerKind kind) {
-  return kind == PreconditionerKind::BlockJacobi ? "block-Jacobi" : "MC Gauss-Seidel";
+  switch (kind) {
+    case PreconditionerKind::BlockJacobi: return "block-Jacobi";
+    case PreconditionerKind::MulticolorGaussSeidel: return "MC Gauss-Seidel";
+    case PreconditionerKind::TwoLevelGaussSeidel: return "two-level";
+    case PreconditionerKind::Automatic: break;
+  }
+  return "automatic";
 }
 
 RunFigures runCurtain(Index size, int frames, int threads, PreconditionerKind kind) {
@@ -112,32 +120,48 @@ RunFigures runStiffSheet(Real factor, int threads, PreconditionerKind kind) {
   return figures;
 }
 
-void print(const std::string& scene, const RunFigures& jacobi, const RunFigures& gaussSeidel) {
-  auto row = [&](PreconditionerKind kind, const RunFigures& f) {
+/// The preconditioners compared, in the order they run within each repeat.
+constexpr std::array<PreconditionerKind, 3> kKinds = {PreconditionerKind::BlockJacobi,
+                                                      PreconditionerKind::MulticolorGaussSeidel,
+                                                      PreconditionerKind::TwoLevelGaussSeidel};
+
+void print(const std::string& scene, const std::array<RunFigures, kKinds.size()>& figures) {
+  const auto perSolve = [](const RunFigures& f) {
+    return double(f.iterations) / double(std::max(1L, f.solves));
+  };
+  for (std::size_t k = 0; k < kKinds.size(); ++k) {
+    const RunFigures& f = figures[k];
     std::printf("  %-16s %-16s it/solve %6.1f  max/frame %4d  cap frames %3d  solve ms/frame %7.3f"
                 "  cpu ms/frame %7.3f  wall ms/frame %7.3f  strain %.4f  hash 0x%016" PRIx64 "\n",
-                scene.c_str(), name(kind), double(f.iterations) / std::max(1L, f.solves),
-                f.maxIterationsPerFrame, f.capFrames, f.solveMs / f.frames, f.cpuMs / f.frames,
-                f.wallMs / f.frames, f.maxStrain, f.hash);
-  };
-  row(PreconditionerKind::BlockJacobi, jacobi);
-  row(PreconditionerKind::MulticolorGaussSeidel, gaussSeidel);
-  const double iterationRatio = (double(gaussSeidel.iterations) / std::max(1L, gaussSeidel.solves)) /
-                                (double(jacobi.iterations) / std::max(1L, jacobi.solves));
-  std::printf("  %-16s ratio G/J: iterations %.3f  solve ms %.3f  cpu ms/frame %.3f  wall %.3f\n\n",
-              scene.c_str(), iterationRatio, gaussSeidel.solveMs / jacobi.solveMs,
-              gaussSeidel.cpuMs / jacobi.cpuMs, gaussSeidel.wallMs / jacobi.wallMs);
+                scene.c_str(), name(kKinds[k]), perSolve(f), f.maxIterationsPerFrame, f.capFrames,
+                f.solveMs / f.frames, f.cpuMs / f.frames, f.wallMs / f.frames, f.maxStrain, f.hash);
+  }
+  // Ratios against multicolour Gauss–Seidel, the preconditioner below the two-level threshold.
+  const RunFigures& base = figures[1];
+  for (std::size_t k : {std::size_t(0), std::size_t(2)}) {
+    const RunFigures& f = figures[k];
+    std::printf("  %-16s ratio %s / Gauss-Seidel: iterations %.3f  solve ms %.3f  cpu ms/frame %.3f"
+                "  wall %.3f\n",
+                scene.c_str(), name(kKinds[k]), perSolve(f) / perSolve(base), f.solveMs / base.solveMs,
+                f.cpuMs / base.cpuMs, f.wallMs / base.wallMs);
+  }
+  std::printf("\n");
 }
 
 template <typename Run>
 void compare(const std::string& scene, int repeats, Run&& run) {
-  RunFigures jacobi = run(PreconditionerKind::BlockJacobi);
-  RunFigures gaussSeidel = run(PreconditionerKind::MulticolorGaussSeidel);
-  for (int repeat = 1; repeat < repeats; ++repeat) {
-    jacobi.keepFaster(run(PreconditionerKind::BlockJacobi));
-    gaussSeidel.keepFaster(run(PreconditionerKind::MulticolorGaussSeidel));
+  std::array<RunFigures, kKinds.size()> figures;
+  for (int repeat = 0; repeat < repeats; ++repeat) {
+    for (std::size_t k = 0; k < kKinds.size(); ++k) {
+      RunFigures f = run(kKinds[k]);
+      if (repeat == 0) {
+        figures[k] = f;
+      } else {
+        figures[k].keepFaster(f);
+      }
+    }
   }
-  print(scene, jacobi, gaussSeidel);
+  print(scene, figures);
 }
 
 }  // namespace
@@ -145,7 +169,7 @@ void compare(const std::string& scene, int repeats, Run&& run) {
 
 int main(int argc, char** argv) {
   using namespace weft;
-  CLI::App app{"Block-Jacobi vs multicolour Gauss-Seidel PCG on the curtain and stress scene 2"};
+  CLI::App app{"Block-Jacobi, multicolour Gauss-Seidel and two-level PCG on the curtain and stress scene 2"};
   int frames = 600;
   int threads = 1;
   int repeats = 2;

@@ -9,6 +9,8 @@
 
 #include <weft/threading/TaskSystem.h>
 
+#include "RandomVectors.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -22,10 +24,7 @@ namespace {
 
 using Pair = std::array<Index, 2>;
 
-Vec3 randomVec3(std::mt19937& random) {
-  std::uniform_real_distribution<Real> uniform(-1, 1);
-  return Vec3(uniform(random), uniform(random), uniform(random));
-}
+using test::randomVec3;
 
 Eigen::VectorXd flatten(const Vec3Array& x) {
   Eigen::VectorXd flat(3 * x.size());
@@ -322,10 +321,13 @@ TEST_P(ContactCouplingPcgTest, ACouplingRowOutOfRangeIsRejected) {
 
 INSTANTIATE_TEST_SUITE_P(Preconditioners, ContactCouplingPcgTest,
                          ::testing::Values(PreconditionerKind::BlockJacobi,
-                                           PreconditionerKind::MulticolorGaussSeidel),
+                                           PreconditionerKind::MulticolorGaussSeidel,
+                                           PreconditionerKind::TwoLevelGaussSeidel),
                          [](const ::testing::TestParamInfo<PreconditionerKind>& info) {
                            return info.param == PreconditionerKind::BlockJacobi ? "BlockJacobi"
-                                                                                : "GaussSeidel";
+                                  : info.param == PreconditionerKind::MulticolorGaussSeidel
+                                      ? "GaussSeidel"
+                                      : "TwoLevel";
                          });
 
 }  // namespace

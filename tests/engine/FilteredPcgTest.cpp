@@ -6,6 +6,8 @@
 
 #include <weft/threading/TaskSystem.h>
 
+#include "RandomVectors.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -28,10 +30,7 @@ Eigen::VectorXd flatten(const Vec3Array& x) {
   return flat;
 }
 
-Vec3 randomVec3(std::mt19937& random) {
-  std::uniform_real_distribution<Real> uniform(-1, 1);
-  return Vec3(uniform(random), uniform(random), uniform(random));
-}
+using test::randomVec3;
 
 /// A M + Σ element-stiffness system on a triangulated grid (the pattern of a cloth), plus a few
 /// long-range couplings (like self-contacts): SPD, with non-symmetric off-diagonal blocks
@@ -638,10 +637,13 @@ TEST_P(FilteredPcgTest, MismatchedSizesAreRejected) {
 
 INSTANTIATE_TEST_SUITE_P(Preconditioners, FilteredPcgTest,
                          ::testing::Values(PreconditionerKind::BlockJacobi,
-                                           PreconditionerKind::MulticolorGaussSeidel),
+                                           PreconditionerKind::MulticolorGaussSeidel,
+                                           PreconditionerKind::TwoLevelGaussSeidel),
                          [](const ::testing::TestParamInfo<PreconditionerKind>& info) {
                            return info.param == PreconditionerKind::BlockJacobi ? "BlockJacobi"
-                                                                                : "GaussSeidel";
+                                  : info.param == PreconditionerKind::MulticolorGaussSeidel
+                                      ? "GaussSeidel"
+                                      : "TwoLevel";
                          });
 
 }  // namespace

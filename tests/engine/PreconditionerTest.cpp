@@ -13,6 +13,8 @@
 #include <weft/engine/ClothModel.h>
 #include <weft/threading/TaskSystem.h>
 
+#include "RandomVectors.h"
+
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -27,10 +29,7 @@ namespace {
 
 using Pair = std::array<Index, 2>;
 
-Vec3 randomVec3(std::mt19937& random) {
-  std::uniform_real_distribution<Real> uniform(-1, 1);
-  return Vec3(uniform(random), uniform(random), uniform(random));
-}
+using test::randomVec3;
 
 /// A grid-patterned SPD system (mass + spring-like element stiffnesses with non-symmetric
 /// off-diagonal blocks) plus a few long-range pairs, like FilteredPcgTest's. With `isotropic`,

@@ -265,6 +265,24 @@ Real forwardSweepRange(Index begin, Index end, const PackedTriangle& lower,
   return sum;
 }
 
+/// q = S Ã c = S(D̃ c + L̃ c + Ũ c) over sweep positions [begin, end), from the packed blocks (half
+/// the bytes of A's own); returns Σ cᵀq over the positions in order.
+Real packedProductRange(Index begin, Index end, const PackedTriangle& lower,
+                        const PackedTriangle& upper, const MulticolorOrdering& ordering,
+                        const std::vector<Mat3>& diagonal, const VertexFilter& filter,
+                        const Vec3Array& c, Vec3Array& q) {
+  Real sum = 0;
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = ordering.order()[k];
+    Vec3 product = diagonal[vertex] * c[vertex];
+    product += triangleProduct(k, ordering.lower(), lower, c);
+    product += triangleProduct(k, ordering.upper(), upper, c);
+    q[vertex] = filter.filter(vertex, product);
+    sum += c[vertex].dot(q[vertex]);
+  }
+  return sum;
+}
+
 /// ŝ = D̃ r̂ over the range (the transformed system's preconditioner); returns Σ r̂ᵀŝ.
 Real diagonalRange(Index begin, Index end, const std::vector<Mat3>& diagonal,
                    const VertexFilter& filter, const Vec3Array& r, Vec3Array& s) {
@@ -433,11 +451,18 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
   forEachBlock(vertexCount, [&](Index begin, Index end) {
     buildPreconditionerRange(begin, end, A, filter, m_diagonal, m_inverseDiagonal);
   });
-  if (kind != PreconditionerKind::MulticolorGaussSeidel) {
+  kind = resolve(kind, vertexCount);
+  if (kind == PreconditionerKind::BlockJacobi) {
     for (Index vertex = 0; vertex < vertexCount; ++vertex) z[vertex] = m_inverseDiagonal[vertex] * r[vertex];
     return;
   }
   prepareGaussSeidel(A);
+  if (kind == PreconditionerKind::TwoLevelGaussSeidel) {
+    if (!m_coarseSpace.built(A)) m_coarseSpace.build(A);
+    m_coarseSpace.assemble(A, filter, m_tasks);
+    applyTwoLevel(filter, r, z);
+    return;
+  }
   Vec3Array& w = m_product;
   std::copy(r.begin(), r.end(), w.begin());
   forwardSweep<false>(filter, m_direction, m_backward, w);  // w = P_L⁻¹ r
@@ -531,9 +556,16 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   });
   m_couplings = couplings;
   prepareCouplings(A, filter);
-  const bool gaussSeidel = settings.preconditioner == PreconditionerKind::MulticolorGaussSeidel;
-  // The colouring depends on the pattern only: rebuilt (allocating) when the topology changes.
-  if (gaussSeidel) prepareGaussSeidel(A);
+  const PreconditionerKind kind = resolve(settings.preconditioner, vertexCount);
+  const bool gaussSeidel = kind == PreconditionerKind::MulticolorGaussSeidel;
+  const bool twoLevel = kind == PreconditionerKind::TwoLevelGaussSeidel;
+  // The colouring and the aggregates depend on the pattern only: rebuilt (allocating) when the
+  // topology changes. The coarse matrix is assembled and factorised every solve.
+  if (gaussSeidel || twoLevel) prepareGaussSeidel(A);
+  if (twoLevel) {
+    if (!m_coarseSpace.built(A)) m_coarseSpace.build(A);
+    m_coarseSpace.assemble(A, filter, m_tasks);
+  }
 
   // The velocity test's weights: m_i and 1/m_i on vertices with a free direction, zero on fixed
   // ones (and on a massless row, which a valid system does not have). Σm is the mass that moves.
@@ -609,7 +641,7 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   if (gaussSeidel) {
     iterateGaussSeidel(A, filter, weights, stopping, start, deltaV, report);
   } else {
-    iterateJacobi(A, filter, weights, stopping, start, deltaV, report);
+    iterateJacobi(A, filter, weights, stopping, start, twoLevel, deltaV, report);
   }
   return report;
 }
@@ -659,15 +691,37 @@ bool FilteredPcg::Stopping::judge(Real stopDelta, Real residualDelta, Real solut
   return converged;
 }
 
+Real FilteredPcg::applyTwoLevel(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z) {
+  const Index vertexCount = Index(r.size());
+  Vec3Array& w = m_product;
+  Vec3Array& y = m_backward;
+  forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, r, w); });
+  forwardSweep<false>(filter, m_direction, m_backward, w);  // w = P_L⁻¹ r (c, t unread)
+  sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    return diagonalRange(begin, end, m_diagonal, filter, w, y);  // y = D̃ w
+  });
+  addCouplingDiagonal(filter, w, y);  // y = D̃' w
+  backwardSweep(filter, y, z, w);     // z = P_U⁻¹ y; w is scratch
+  m_coarseSpace.addCorrection(filter, r, z, m_tasks);
+  return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
+    Real sum = 0;
+    for (Index vertex = begin; vertex < end; ++vertex) sum += r[vertex].dot(z[vertex]);
+    return sum;
+  });
+}
+
 void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& filter,
                                 const FilteredPcgMassWeights& weights, const Stopping& stopping,
-                                const FilteredPcgPassSums& start, Vec3Array& deltaV,
-                                SolveReport& report) {
+                                const FilteredPcgPassSums& start, bool twoLevel,
+                                Vec3Array& deltaV, SolveReport& report) {
   const Index vertexCount = A.blockRows();
   Vec3Array& r = m_residual;
   Vec3Array& s = m_preconditioned;
   Vec3Array& c = m_direction;
   Vec3Array& q = m_product;
+  // rᵀP⁻¹r, CG's own measure: the block-Jacobi sum of the pass, or the two-level one, for which
+  // s is overwritten with P⁻¹r once the pass has summed rᵀD̃⁻¹r for the stopping test.
+  Real delta = twoLevel && start.cg > 0 ? applyTwoLevel(filter, r, s) : start.cg;
   forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, s, c); });
   // The velocity test's progress window starts at the initial guess.
   if (stopping.velocityTest) {
@@ -676,7 +730,7 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
   }
 
   PassSums sums = start;
-  Real previousDelta = sums.cg;
+  Real previousDelta = delta;
   for (;;) {
     // The progress over the last window, once w iterations have run (header, "Stopping").
     const bool windowFull = stopping.velocityTest && report.iterations >= stopping.window;
@@ -688,13 +742,15 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
     if (report.iterations >= stopping.maxIterations) break;
 
     if (report.iterations > 0) {
-      const Real beta = sums.cg / previousDelta;
+      const Real beta = delta / previousDelta;
       forEachBlock(vertexCount, [&](Index begin, Index end) {
         directionRange(begin, end, beta, filter, s, c);
       });
     }
     Real curvature = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-      return filteredProductRange(begin, end, A, filter, c, q);
+      return twoLevel ? packedProductRange(begin, end, m_lowerBlocks, m_upperBlocks, m_ordering,
+                                           m_diagonal, filter, c, q)
+                      : filteredProductRange(begin, end, A, filter, c, q);
     });
     // q += S E c over the rows the contact couplings touch (serially, in a fixed order).
     if (const Vec3Array* coupled = couplingProduct(c)) {
@@ -713,14 +769,15 @@ void FilteredPcg::iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& 
       }
       break;
     }
-    const Real alpha = sums.cg / curvature;
-    previousDelta = sums.cg;
+    const Real alpha = delta / curvature;
+    previousDelta = delta;
     const ProgressSlot slot = ringSlot(m_progressRing, vertexCount, stopping.velocityTest,
                                        stopping.window, report.iterations + 1);
     sums = sumOverBlocks(vertexCount, [&](Index begin, Index end) {
       return updateRange(begin, end, alpha, c, q, m_inverseDiagonal, weights, deltaV, r, s,
                          slot);
     });
+    delta = twoLevel && sums.cg > 0 ? applyTwoLevel(filter, r, s) : sums.cg;
     ++report.iterations;
   }
 }

@@ -39,7 +39,24 @@
 //   of full blocks. On the curtain it takes about half the iterations of block Jacobi
 //   (weft-solver-compare, bench/results/solver-defaults.md).
 //   Rejected: natural-order Gauss–Seidel and block IC(0) (sequential sweeps: no parallel version
-//   with the same bits), and multigrid (worth it only well beyond the ×16 curtain).
+//   with the same bits); over-relaxation (SSOR, ω > 1): with a multicolour order it saves no
+//   iterations (curtain ×1 and ×16: ω = 1.2–1.5 within ±5 % of ω = 1, worse beyond).
+// - Two-level (PreconditionerKind::TwoLevelGaussSeidel; Automatic picks it from kTwoLevelRows).
+//   Gauss–Seidel's iterations grow with the mesh's refinement (h²k/m grows with it): the smooth
+//   error, whole regions moving wrongly, falls slowly. The additive two-level preconditioner
+//   P⁻¹ = M_SGS⁻¹ + S P₀ A_c⁻¹ P₀ᵀ S adds an exact solve over aggregates of about 4 × 4 vertices,
+//   each moving as one translation (AggregateCoarseSpace, which has the design of the coarse
+//   level), which removes that error, so the iterations stop growing. It cannot use Eisenstat's
+//   form: an iteration runs both half-sweeps (M_SGS⁻¹ r), the coarse correction and its own SpMV
+//   (from the packed blocks), about twice a Gauss–Seidel iteration, and each solve assembles and
+//   factorises A_c. It pays only where it saves well over half the iterations: on the curtain
+//   ×64 (77,280 rows); it ties on the ×16 (19,320) and loses on the ×4 (4,860);
+//   bench/results/two-level-pcg-2026-11-27.md has the figures. CG runs on the block-Jacobi loop (iterateJacobi), whose update pass still
+//   computes rᵀD̃⁻¹r for the stopping test; s is then overwritten with P⁻¹r. Contact couplings
+//   enter the Gauss–Seidel part as above (E_ii in D̃') and stay out of A_c: a preconditioner need
+//   only be SPD. Rejected: the multiplicative (V-cycle) form (fewer iterations, one more SpMV
+//   each), block Jacobi as the smoother (more iterations, no faster), a second level of
+//   aggregation (the coarse solve is not the cost; the iterations grow).
 // - Stopping, two tests (PcgStopping).
 //   VelocityError (the engine's). What a loose solve must not get wrong is the velocity, so the test
 //   measures the error e = Δv − Δv* in the mass norm ‖e‖_M = √(Σ m_i‖e_i‖²) (√kg·m/s) against
@@ -109,6 +126,7 @@
 //   then holds the last finite iterate.
 #pragma once
 
+#include <solver/AggregateCoarseSpace.h>
 #include <solver/BlockSparseMatrix.h>
 #include <solver/ContactCoupling.h>
 #include <solver/MulticolorOrdering.h>
@@ -194,14 +212,22 @@ struct PackedTriangle {
   std::vector<Real> isotropic;
 };
 
-/// BW98 modified PCG with a filtered block-Jacobi or multicolour Gauss–Seidel preconditioner;
-/// owns its scratch.
+/// BW98 modified PCG with a filtered block-Jacobi, multicolour Gauss–Seidel or two-level
+/// preconditioner; owns its scratch.
 class FilteredPcg {
  public:
   /// Number of vertices whose sums form one partial sum of a reduction. Fixed (not a function of
   /// the thread count) so the summation order, and hence every bit of the result, is too; 256
   /// vertices of the four solver vectors (~24 KB) fit in L1/L2 and amortise a task's overhead.
   static constexpr Index kReductionBlock = 256;
+  /// Rows from which PreconditionerKind::Automatic adds the coarse level (SolverSettings.h).
+  static constexpr Index kTwoLevelRows = 20000;
+  /// The preconditioner `kind` stands for on a system of `rows` rows (Automatic resolved).
+  static PreconditionerKind resolve(PreconditionerKind kind, Index rows) {
+    if (kind != PreconditionerKind::Automatic) return kind;
+    return rows >= kTwoLevelRows ? PreconditionerKind::TwoLevelGaussSeidel
+                                 : PreconditionerKind::MulticolorGaussSeidel;
+  }
   /// A system of fewer rows (8 blocks) is solved on the calling thread: each of its parallel
   /// calls would be a few blocks, whose fork and join cost more than a second thread saves. The
   /// blocks and their order are the same, so are the bits.
@@ -236,7 +262,8 @@ class FilteredPcg {
   void setRowColors(std::span<const Index> rowColors) { m_rowColors = rowColors; }
 
   /// z = P̃⁻¹ r: the preconditioner `kind` built from A (no couplings) and filter exactly as solve() builds it
-  /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r). r should lie in the free subspace
+  /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r; two-level: that plus S P₀ A_c⁻¹ P₀ᵀ r;
+  /// Automatic: the kind it resolves to for A's rows). r should lie in the free subspace
   /// (S r = r); z does, exactly zero at fixed vertices. For tests and diagnostics; sizes as solve().
   void applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
                            PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
@@ -299,10 +326,16 @@ class FilteredPcg {
                SolveReport& report) const;
   };
 
-  /// CG iterations with the block-Jacobi preconditioner from the start residual in r, s.
+  /// CG iterations from the start residual in r (s = D̃⁻¹r) with the block-Jacobi preconditioner,
+  /// or with the two-level one.
   void iterateJacobi(const BlockSparseMatrix& A, const VertexFilter& filter,
                      const FilteredPcgMassWeights& weights, const Stopping& stopping,
-                     const FilteredPcgPassSums& start, Vec3Array& deltaV, SolveReport& report);
+                     const FilteredPcgPassSums& start, bool twoLevel, Vec3Array& deltaV,
+                     SolveReport& report);
+
+  /// z = P⁻¹r for the two-level preconditioner (header, "Two-level"): symmetric Gauss–Seidel plus
+  /// the coarse correction; returns rᵀz. Uses m_product and m_backward as scratch.
+  Real applyTwoLevel(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z);
 
   /// CG iterations with multicolour symmetric Gauss–Seidel (Eisenstat form) from r.
   void iterateGaussSeidel(const BlockSparseMatrix& A, const VertexFilter& filter,
@@ -320,6 +353,7 @@ class FilteredPcg {
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
   std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
   MulticolorOrdering m_ordering;        ///< order of A's rows (Gauss–Seidel only)
+  AggregateCoarseSpace m_coarseSpace;   ///< the two-level preconditioner's coarse level
   PackedTriangle m_lowerBlocks;         ///< A's lower-colour blocks in sweep order (Gauss–Seidel)
   PackedTriangle m_upperBlocks;         ///< A's upper-colour blocks in sweep order (Gauss–Seidel)
   /// The velocity test's last w iterates, slot k mod w holding Δv_k (w · vertex count entries).
