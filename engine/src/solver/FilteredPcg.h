@@ -50,7 +50,7 @@
 //   form: an iteration runs both half-sweeps (M_SGS⁻¹ r), the coarse correction and its own SpMV
 //   (from the packed blocks), about twice a Gauss–Seidel iteration, and each solve assembles and
 //   factorises A_c. It pays only where it saves well over half the iterations: on the curtain
-//   ×64 (77,280 rows); it ties on the ×16 (19,320) and loses on the ×4 (4,860);
+//   ×64 (77,040 rows); it ties on the ×16 (19,320) and loses on the ×4 (4,860);
 //   bench/results/two-level-pcg-2026-11-27.md has the figures. CG runs on the block-Jacobi loop (iterateJacobi), whose update pass still
 //   computes rᵀD̃⁻¹r for the stopping test; s is then overwritten with P⁻¹r. Contact couplings
 //   enter the Gauss–Seidel part as above (E_ii in D̃') and stay out of A_c: a preconditioner need

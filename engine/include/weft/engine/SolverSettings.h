@@ -47,7 +47,7 @@ enum class PreconditionerKind {
   /// each costing about two of Gauss–Seidel's, plus a factorisation per solve.
   TwoLevelGaussSeidel,
   /// MulticolorGaussSeidel below 20,000 free vertices, TwoLevelGaussSeidel from there (on the
-  /// curtain the two tie at 19,320 vertices; at 77,280 the two-level solve takes 0.42× the time).
+  /// curtain the two tie at 19,320 vertices; at 77,040 the two-level solve takes 0.42× the time).
   Automatic,
 };
 
