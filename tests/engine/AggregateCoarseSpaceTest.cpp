@@ -154,7 +154,7 @@ TEST(AggregateCoarseSpace, TheCorrectionIsTheGalerkinSolveOfTheFilteredSystem) {
     }
     const Eigen::VectorXd expected = S * P * pseudoInverse * P.transpose() * S * flat;
     EXPECT_LE((got - expected).norm(), 1e-7 * expected.norm()) << "trial " << trial;
-    EXPECT_NEAR(sum, flat.dot(got), 1e-12 * std::abs(sum) + 1e-300);
+    EXPECT_NEAR(sum, flat.dot(got), 1e-12 * std::abs(sum) + 1e-300);  // z started at zero
     for (Index i = 0; i < n; ++i) {
       if (filter.kind(i) == ConstraintKind::Fixed) {
         EXPECT_EQ(z[i], Vec3::Zero()) << "row " << i;

@@ -232,9 +232,8 @@ Real AggregateCoarseSpace::addCorrection(const VertexFilter& filter, const Vec3A
       const Index base = 3 * m_aggregateOf[row];
       const Vec3 motion(m_coarse[m_coarseIndex[base]], m_coarse[m_coarseIndex[base + 1]],
                         m_coarse[m_coarseIndex[base + 2]]);
-      const Vec3 correction = filter.filter(row, motion);
-      z[row] += correction;
-      sum += r[row].dot(correction);
+      z[row] += filter.filter(row, motion);
+      sum += r[row].dot(z[row]);
     }
     return sum;
   };

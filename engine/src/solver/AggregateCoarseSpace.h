@@ -66,7 +66,9 @@ class AggregateCoarseSpace {
   /// `tasks` runs it over the aggregates (null: serial); the result does not depend on it.
   bool assemble(const BlockSparseMatrix& A, const VertexFilter& filter, TaskSystem* tasks);
 
-  /// z += S P₀ A_c⁻¹ P₀ᵀ r, for r in the free subspace (S r = r); returns Σ rᵀ(S P₀ A_c⁻¹ P₀ᵀ r).
+  /// z += S P₀ A_c⁻¹ P₀ᵀ r, for r in the free subspace (S r = r); returns rᵀz, z as updated (the
+  /// preconditioner's rᵀP⁻¹r when z held the smoother's part). Adds nothing and returns 0 when
+  /// A_c is not factorised.
   /// `tasks` runs the prolongation (null: serial); the result does not depend on it.
   Real addCorrection(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z,
                      TaskSystem* tasks);

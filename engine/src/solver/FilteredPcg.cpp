@@ -265,6 +265,22 @@ Real forwardSweepRange(Index begin, Index end, const PackedTriangle& lower,
   return sum;
 }
 
+/// The two-level preconditioner's forward sweep over sweep positions [begin, end) of one colour:
+/// w = P_L⁻¹ r (w_i = D̃_i⁻¹(r_i − Σ_{earlier j} A_ij w_j)) and y_i = S_i D̃_i w_i, the input of its
+/// backward sweep, in the same pass.
+void twoLevelForwardRange(Index begin, Index end, const PackedTriangle& lower,
+                          const MulticolorOrdering& ordering, const VertexFilter& filter,
+                          const std::vector<Mat3>& inverseDiagonal,
+                          const std::vector<Mat3>& diagonal, const Vec3Array& r, Vec3Array& w,
+                          Vec3Array& y) {
+  for (Index k = begin; k < end; ++k) {
+    const Index vertex = ordering.order()[k];
+    const Vec3 rest = r[vertex] - triangleProduct(k, ordering.lower(), lower, w);
+    w[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * rest);
+    y[vertex] = filter.filter(vertex, diagonal[vertex] * w[vertex]);
+  }
+}
+
 /// q = S Ã c = S(D̃ c + L̃ c + Ũ c) over sweep positions [begin, end), from the packed blocks (half
 /// the bytes of A's own); returns Σ cᵀq over the positions in order.
 Real packedProductRange(Index begin, Index end, const PackedTriangle& lower,
@@ -695,14 +711,18 @@ Real FilteredPcg::applyTwoLevel(const VertexFilter& filter, const Vec3Array& r, 
   const Index vertexCount = Index(r.size());
   Vec3Array& w = m_product;
   Vec3Array& y = m_backward;
-  forEachBlock(vertexCount, [&](Index begin, Index end) { copyRange(begin, end, r, w); });
-  forwardSweep<false>(filter, m_direction, m_backward, w);  // w = P_L⁻¹ r (c, t unread)
-  sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-    return diagonalRange(begin, end, m_diagonal, filter, w, y);  // y = D̃ w
-  });
+  // w = P_L⁻¹ r and y = D̃ w in one pass, colour by colour.
+  for (Index color = 0; color < m_ordering.colorCount(); ++color) {
+    const Index first = m_ordering.colorBegin(color);
+    forEachBlock(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+      twoLevelForwardRange(first + begin, first + end, m_lowerBlocks, m_ordering, filter,
+                           m_inverseDiagonal, m_diagonal, r, w, y);
+    });
+  }
   addCouplingDiagonal(filter, w, y);  // y = D̃' w
   backwardSweep(filter, y, z, w);     // z = P_U⁻¹ y; w is scratch
-  m_coarseSpace.addCorrection(filter, r, z, m_tasks);
+  // The coarse correction's pass also sums rᵀz; without a factorised A_c, a pass of its own.
+  if (m_coarseSpace.factorised()) return m_coarseSpace.addCorrection(filter, r, z, m_tasks);
   return sumOverBlocks(vertexCount, [&](Index begin, Index end) {
     Real sum = 0;
     for (Index vertex = begin; vertex < end; ++vertex) sum += r[vertex].dot(z[vertex]);

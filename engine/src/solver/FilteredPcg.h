@@ -50,8 +50,10 @@
 //   form: an iteration runs both half-sweeps (M_SGS⁻¹ r), the coarse correction and its own SpMV
 //   (from the packed blocks), about twice a Gauss–Seidel iteration, and each solve assembles and
 //   factorises A_c. It pays only where it saves well over half the iterations: on the curtain
-//   ×64 (77,040 rows); it ties on the ×16 (19,320) and loses on the ×4 (4,860);
-//   bench/results/two-level-pcg-2026-11-27.md has the figures. CG runs on the block-Jacobi loop (iterateJacobi), whose update pass still
+//   ×16 (19,320 rows) and ×64 (77,040), not on the ×4 (4,860); the threshold lies where the
+//   solve-time ratio, interpolated between ×4 and ×16, crosses 1
+//   (bench/results/two-level-pcg-2026-11-27.md has the figures). The forward sweep also forms
+//   D̃ P_L⁻¹ r, and the prolongation sums rᵀz, to spare two passes. CG runs on the block-Jacobi loop (iterateJacobi), whose update pass still
 //   computes rᵀD̃⁻¹r for the stopping test; s is then overwritten with P⁻¹r. Contact couplings
 //   enter the Gauss–Seidel part as above (E_ii in D̃') and stay out of A_c: a preconditioner need
 //   only be SPD. Rejected: the multiplicative (V-cycle) form (fewer iterations, one more SpMV
@@ -221,7 +223,7 @@ class FilteredPcg {
   /// vertices of the four solver vectors (~24 KB) fit in L1/L2 and amortise a task's overhead.
   static constexpr Index kReductionBlock = 256;
   /// Rows from which PreconditionerKind::Automatic adds the coarse level (SolverSettings.h).
-  static constexpr Index kTwoLevelRows = 20000;
+  static constexpr Index kTwoLevelRows = 14000;
   /// The preconditioner `kind` stands for on a system of `rows` rows (Automatic resolved).
   static PreconditionerKind resolve(PreconditionerKind kind, Index rows) {
     if (kind != PreconditionerKind::Automatic) return kind;

@@ -46,8 +46,8 @@ enum class PreconditionerKind {
   /// as one translation, solved exactly: iterations that stop growing with the mesh's refinement,
   /// each costing about two of Gauss–Seidel's, plus a factorisation per solve.
   TwoLevelGaussSeidel,
-  /// MulticolorGaussSeidel below 20,000 free vertices, TwoLevelGaussSeidel from there (on the
-  /// curtain the two tie at 19,320 vertices; at 77,040 the two-level solve takes 0.42× the time).
+  /// MulticolorGaussSeidel below 14,000 free vertices, TwoLevelGaussSeidel from there (the ×4
+  /// curtain's 4,860 solve faster without the coarse level, the ×16's 19,320 with it).
   Automatic,
 };
 
