@@ -4,12 +4,13 @@
 //
 //   build/bench/weft-solver-compare [--frames 600] [--sizes 1,4] [--threads 1] [--repeats 2]
 //
-// Every run is repeated and the preconditioners alternate (J, G, T, J, G, T, …), so a machine shared
-// with other jobs slows both alike; a frame's time is the calling thread's CPU time for
+// Every run is repeated and the preconditioners alternate (J, G, T, J, G, T, …), so a machine
+// shared with other jobs slows them alike; a frame's time is the calling thread's CPU time for
 // World::step (plus wall time, which also shows waits), the smaller of the repeats is kept. The
 // report gives, per scene: PCG iterations per solve (mean, max), solves at the cap, solve ms
-// (World's own wall-clock measure), simulation CPU ms per frame and the ratios to Gauss–Seidel, and the
-// curtain's state hash per preconditioner (thread-count independent; compare with weft-curtain).
+// (World's own wall-clock measure), simulation CPU ms per frame and the ratios to Gauss–Seidel,
+// and the curtain's state hash per preconditioner (thread-count independent; compare with
+// weft-curtain).
 #include "BenchClock.h"
 
 #include <weft/scenes/Curtain.h>
@@ -142,8 +143,8 @@ void print(const std::string& scene, const std::array<RunFigures, kKinds.size()>
     const RunFigures& f = figures[k];
     std::printf("  %-16s ratio %s / Gauss-Seidel: iterations %.3f  solve ms %.3f  cpu ms/frame %.3f"
                 "  wall %.3f\n",
-                scene.c_str(), name(kKinds[k]), perSolve(f) / perSolve(base), f.solveMs / base.solveMs,
-                f.cpuMs / base.cpuMs, f.wallMs / base.wallMs);
+                scene.c_str(), name(kKinds[k]), perSolve(f) / perSolve(base),
+                f.solveMs / base.solveMs, f.cpuMs / base.cpuMs, f.wallMs / base.wallMs);
   }
   std::printf("\n");
 }
@@ -169,7 +170,8 @@ void compare(const std::string& scene, int repeats, Run&& run) {
 
 int main(int argc, char** argv) {
   using namespace weft;
-  CLI::App app{"Block-Jacobi, multicolour Gauss-Seidel and two-level PCG on the curtain and stress scene 2"};
+  CLI::App app{
+      "Block-Jacobi, multicolour Gauss-Seidel and two-level PCG on the curtain and stress scene 2"};
   int frames = 600;
   int threads = 1;
   int repeats = 2;

@@ -105,7 +105,8 @@ TEST(AggregateCoarseSpace, EveryRowJoinsOneAggregateWithAPatternNeighbour) {
     if (members[aggregate] == 1) continue;
     bool neighbour = false;
     for (Index slot = A.rowBegin(row); slot < A.rowEnd(row); ++slot) {
-      neighbour = neighbour || (A.column(slot) != row && coarse.aggregateOf()[A.column(slot)] == aggregate);
+      const Index column = A.column(slot);
+      neighbour = neighbour || (column != row && coarse.aggregateOf()[column] == aggregate);
     }
     EXPECT_TRUE(neighbour) << "row " << row;
   }

@@ -21,7 +21,9 @@ Index aggregateGraph(Index nodes, Neighbours&& neighbours, std::vector<Index>& a
   for (Index node = 0; node < nodes; ++node) {
     if (aggregateOf[node] != kInvalidIndex) continue;
     bool neighboursFree = true;
-    neighbours(node, [&](Index other) { neighboursFree = neighboursFree && aggregateOf[other] == kInvalidIndex; });
+    neighbours(node, [&](Index other) {
+      neighboursFree = neighboursFree && aggregateOf[other] == kInvalidIndex;
+    });
     if (!neighboursFree) continue;
     neighbours(node, [&](Index other) { aggregateOf[other] = count; });
     aggregateOf[node] = count++;
@@ -240,7 +242,9 @@ Real AggregateCoarseSpace::addCorrection(const VertexFilter& filter, const Vec3A
   constexpr Index kGrain = 2048;
   if (!tasks) {
     Real sum = 0;
-    for (Index begin = 0; begin < rows; begin += kGrain) sum += prolong(begin, std::min(rows, begin + kGrain));
+    for (Index begin = 0; begin < rows; begin += kGrain) {
+      sum += prolong(begin, std::min(rows, begin + kGrain));
+    }
     return sum;
   }
   return tasks->parallelReduce(rows, kGrain, Real(0), prolong,

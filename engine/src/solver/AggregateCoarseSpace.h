@@ -95,9 +95,9 @@ class AggregateCoarseSpace {
   std::uint64_t m_patternId = 0;
   Index m_aggregateCount = 0;
   std::vector<Index> m_aggregateOf;        ///< aggregate per row
-  std::vector<Index> m_memberOffsets;      ///< aggregate I's rows: m_members[offsets[I], offsets[I + 1])
+  std::vector<Index> m_memberOffsets;      ///< per aggregate, where its rows start in m_members
   std::vector<Index> m_members;            ///< rows by aggregate, in row order within one
-  std::vector<Index> m_blockRowOffsets;    ///< aggregate I's blocks (I, J): [offsets[I], offsets[I + 1])
+  std::vector<Index> m_blockRowOffsets;    ///< per aggregate I, where its blocks (I, J) start
   std::vector<Index> m_slotBlock;          ///< per slot of A: its coarse block (I, J)
   std::vector<Mat3> m_blocks;              ///< coarse blocks (I, J), summed by assemble()
   std::vector<Index> m_diagonalBlock;      ///< per aggregate: its block (I, I)

@@ -53,8 +53,9 @@
 //   ×16 (19,320 rows) and ×64 (77,040), not on the ×4 (4,860); the threshold lies where the
 //   solve-time ratio, interpolated between ×4 and ×16, crosses 1
 //   (bench/results/two-level-pcg-2026-11-27.md has the figures). The forward sweep also forms
-//   D̃ P_L⁻¹ r, and the prolongation sums rᵀz, to spare two passes. CG runs on the block-Jacobi loop (iterateJacobi), whose update pass still
-//   computes rᵀD̃⁻¹r for the stopping test; s is then overwritten with P⁻¹r. Contact couplings
+//   D̃ P_L⁻¹ r, and the prolongation sums rᵀz, to spare two passes. CG runs on the block-Jacobi
+//   loop (iterateJacobi), whose update pass still computes rᵀD̃⁻¹r for the stopping test; s is
+//   then overwritten with P⁻¹r. Contact couplings
 //   enter the Gauss–Seidel part as above (E_ii in D̃') and stay out of A_c: a preconditioner need
 //   only be SPD. Rejected: the multiplicative (V-cycle) form (fewer iterations, one more SpMV
 //   each), block Jacobi as the smoother (more iterations, no faster), a second level of
