@@ -67,10 +67,9 @@ const char* name(PreconditionerKind kind) {
   switch (kind) {
     case PreconditionerKind::BlockJacobi: return "block-Jacobi";
     case PreconditionerKind::MulticolorGaussSeidel: return "MC Gauss-Seidel";
-    case PreconditionerKind::TwoLevelGaussSeidel: return "two-level";
-    case PreconditionerKind::Automatic: break;
+    case PreconditionerKind::TwoLevelGaussSeidel: break;
   }
-  return "automatic";
+  return "two-level";
 }
 
 RunFigures runCurtain(Index size, int frames, int threads, PreconditionerKind kind) {

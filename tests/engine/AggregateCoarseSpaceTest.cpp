@@ -233,20 +233,5 @@ TEST(TwoLevelPcg, IterationsDoNotGrowWithRefinementAsGaussSeidelsDo) {
   EXPECT_LT(twoLevelFine, gaussSeidelFine / 2);
 }
 
-TEST(TwoLevelPcg, AutomaticAddsTheCoarseLevelFromItsThresholdOn) {
-  const Index threshold = FilteredPcg::kTwoLevelRows;
-  EXPECT_EQ(FilteredPcg::resolve(PreconditionerKind::Automatic, threshold - 1),
-            PreconditionerKind::MulticolorGaussSeidel);
-  EXPECT_EQ(FilteredPcg::resolve(PreconditionerKind::Automatic, threshold),
-            PreconditionerKind::TwoLevelGaussSeidel);
-  for (PreconditionerKind kind : {PreconditionerKind::BlockJacobi,
-                                  PreconditionerKind::MulticolorGaussSeidel,
-                                  PreconditionerKind::TwoLevelGaussSeidel}) {
-    EXPECT_EQ(FilteredPcg::resolve(kind, 3 * threshold), kind);
-    EXPECT_EQ(FilteredPcg::resolve(kind, 1), kind);
-  }
-  EXPECT_EQ(SolverSettings{}.preconditioner, PreconditionerKind::Automatic);
-}
-
 }  // namespace
 }  // namespace weft

@@ -467,7 +467,6 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
   forEachBlock(vertexCount, [&](Index begin, Index end) {
     buildPreconditionerRange(begin, end, A, filter, m_diagonal, m_inverseDiagonal);
   });
-  kind = resolve(kind, vertexCount);
   if (kind == PreconditionerKind::BlockJacobi) {
     for (Index vertex = 0; vertex < vertexCount; ++vertex) z[vertex] = m_inverseDiagonal[vertex] * r[vertex];
     return;
@@ -572,9 +571,8 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   });
   m_couplings = couplings;
   prepareCouplings(A, filter);
-  const PreconditionerKind kind = resolve(settings.preconditioner, vertexCount);
-  const bool gaussSeidel = kind == PreconditionerKind::MulticolorGaussSeidel;
-  const bool twoLevel = kind == PreconditionerKind::TwoLevelGaussSeidel;
+  const bool gaussSeidel = settings.preconditioner == PreconditionerKind::MulticolorGaussSeidel;
+  const bool twoLevel = settings.preconditioner == PreconditionerKind::TwoLevelGaussSeidel;
   // The colouring and the aggregates depend on the pattern only: rebuilt (allocating) when the
   // topology changes. The coarse matrix is assembled and factorised every solve.
   if (gaussSeidel || twoLevel) prepareGaussSeidel(A);

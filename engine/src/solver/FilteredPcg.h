@@ -41,7 +41,7 @@
 //   Rejected: natural-order Gauss–Seidel and block IC(0) (sequential sweeps: no parallel version
 //   with the same bits); over-relaxation (SSOR, ω > 1): with a multicolour order it saves no
 //   iterations (curtain ×1 and ×16: ω = 1.2–1.5 within ±5 % of ω = 1, worse beyond).
-// - Two-level (PreconditionerKind::TwoLevelGaussSeidel; Automatic picks it from kTwoLevelRows).
+// - Two-level (PreconditionerKind::TwoLevelGaussSeidel, opt-in).
 //   Gauss–Seidel's iterations grow with the mesh's refinement (h²k/m grows with it): the smooth
 //   error, whole regions moving wrongly, falls slowly. The additive two-level preconditioner
 //   P⁻¹ = M_SGS⁻¹ + S P₀ A_c⁻¹ P₀ᵀ S adds an exact solve over aggregates of about 4 × 4 vertices,
@@ -50,8 +50,8 @@
 //   form: an iteration runs both half-sweeps (M_SGS⁻¹ r), the coarse correction and its own SpMV
 //   (from the packed blocks), about twice a Gauss–Seidel iteration, and each solve assembles and
 //   factorises A_c. It pays only where it saves well over half the iterations: on the curtain
-//   ×16 (19,320 rows) and ×64 (77,040), not on the ×4 (4,860); the threshold lies where the
-//   solve-time ratio, interpolated between ×4 and ×16, crosses 1
+//   ×16 and ×64 while the cloth hangs free, not once contacts make the solves short, where it
+//   saves a third (the whole ×16 script: 1.5× Gauss–Seidel's solve time); not on the ×4 at all
 //   (bench/results/two-level-pcg-2026-11-27.md has the figures). The forward sweep also forms
 //   D̃ P_L⁻¹ r, and the prolongation sums rᵀz, to spare two passes. CG runs on the block-Jacobi
 //   loop (iterateJacobi), whose update pass still computes rᵀD̃⁻¹r for the stopping test; s is
@@ -223,14 +223,6 @@ class FilteredPcg {
   /// the thread count) so the summation order, and hence every bit of the result, is too; 256
   /// vertices of the four solver vectors (~24 KB) fit in L1/L2 and amortise a task's overhead.
   static constexpr Index kReductionBlock = 256;
-  /// Rows from which PreconditionerKind::Automatic adds the coarse level (SolverSettings.h).
-  static constexpr Index kTwoLevelRows = 14000;
-  /// The preconditioner `kind` stands for on a system of `rows` rows (Automatic resolved).
-  static PreconditionerKind resolve(PreconditionerKind kind, Index rows) {
-    if (kind != PreconditionerKind::Automatic) return kind;
-    return rows >= kTwoLevelRows ? PreconditionerKind::TwoLevelGaussSeidel
-                                 : PreconditionerKind::MulticolorGaussSeidel;
-  }
   /// A system of fewer rows (8 blocks) is solved on the calling thread: each of its parallel
   /// calls would be a few blocks, whose fork and join cost more than a second thread saves. The
   /// blocks and their order are the same, so are the bits.
@@ -265,8 +257,8 @@ class FilteredPcg {
   void setRowColors(std::span<const Index> rowColors) { m_rowColors = rowColors; }
 
   /// z = P̃⁻¹ r: the preconditioner `kind` built from A (no couplings) and filter exactly as solve() builds it
-  /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r; two-level: that plus S P₀ A_c⁻¹ P₀ᵀ r;
-  /// Automatic: the kind it resolves to for A's rows). r should lie in the free subspace
+  /// (block Jacobi: D̃⁻¹ r; Gauss–Seidel: P_U⁻¹ D̃ P_L⁻¹ r; two-level: that plus S P₀ A_c⁻¹ P₀ᵀ r).
+  /// r should lie in the free subspace
   /// (S r = r); z does, exactly zero at fixed vertices. For tests and diagnostics; sizes as solve().
   void applyPreconditioner(const BlockSparseMatrix& A, const VertexFilter& filter,
                            PreconditionerKind kind, const Vec3Array& r, Vec3Array& z,
