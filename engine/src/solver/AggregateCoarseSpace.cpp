@@ -145,17 +145,15 @@ void AggregateCoarseSpace::build(const BlockSparseMatrix& A) {
 
 bool AggregateCoarseSpace::assemble(const BlockSparseMatrix& A, const VertexFilter& filter,
                                     TaskSystem* tasks) {
+  if (!built(A)) build(A);
   m_factorised = false;
   // Aggregate I's rows write only the blocks (I, J), each in its rows' order: any split of the
   // aggregates over threads gives the same sums.
   const auto assembleAggregates = [&](Index begin, Index end) {
     Real nonFinite = 0;
     for (Index aggregate = begin; aggregate < end; ++aggregate) {
-      for (Index k = m_memberOffsets[aggregate]; k < m_memberOffsets[aggregate + 1]; ++k) {
-        const Index row = m_members[k];
-        for (Index slot = A.rowBegin(row); slot < A.rowEnd(row); ++slot) {
-          m_blocks[m_slotBlock[slot]].setZero();
-        }
+      for (Index b = m_blockRowOffsets[aggregate]; b < m_blockRowOffsets[aggregate + 1]; ++b) {
+        m_blocks[b].setZero();
       }
       for (Index k = m_memberOffsets[aggregate]; k < m_memberOffsets[aggregate + 1]; ++k) {
         const Index row = m_members[k];

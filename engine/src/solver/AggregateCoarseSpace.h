@@ -61,8 +61,9 @@ class AggregateCoarseSpace {
     return m_patternId == A.patternId() && m_aggregateOf.size() == A.blockRows();
   }
 
-  /// A_c = P₀ᵀ S A S P₀ from A's values and the filter, then its LDLᵀ factorisation. False when
-  /// the factorisation fails (a non-finite or indefinite A); addCorrection() then adds nothing.
+  /// A_c = P₀ᵀ S A S P₀ from A's values and the filter, then its LDLᵀ factorisation; build()s
+  /// first when A's pattern is new (allocating then). False when the factorisation fails (a
+  /// non-finite or indefinite A); addCorrection() then adds nothing.
   /// `tasks` runs it over the aggregates (null: serial); the result does not depend on it.
   bool assemble(const BlockSparseMatrix& A, const VertexFilter& filter, TaskSystem* tasks);
 

@@ -265,10 +265,10 @@ Real forwardSweepRange(Index begin, Index end, const PackedTriangle& lower,
   return sum;
 }
 
-/// The two-level preconditioner's forward sweep over sweep positions [begin, end) of one colour:
-/// w = P_L⁻¹ r (w_i = D̃_i⁻¹(r_i − Σ_{earlier j} A_ij w_j)) and y_i = S_i D̃_i w_i, the input of its
+/// The forward sweep of M_SGS⁻¹ r over sweep positions [begin, end) of one colour:
+/// w = P_L⁻¹ r (w_i = D̃_i⁻¹(r_i − Σ_{earlier j} A_ij w_j)) and y_i = S_i D̃_i w_i, the input of the
 /// backward sweep, in the same pass.
-void twoLevelForwardRange(Index begin, Index end, const PackedTriangle& lower,
+void forwardSweepWithDiagonalRange(Index begin, Index end, const PackedTriangle& lower,
                           const MulticolorOrdering& ordering, const VertexFilter& filter,
                           const std::vector<Mat3>& inverseDiagonal,
                           const std::vector<Mat3>& diagonal, const Vec3Array& r, Vec3Array& w,
@@ -473,18 +473,11 @@ void FilteredPcg::applyPreconditioner(const BlockSparseMatrix& A, const VertexFi
   }
   prepareGaussSeidel(A);
   if (kind == PreconditionerKind::TwoLevelGaussSeidel) {
-    if (!m_coarseSpace.built(A)) m_coarseSpace.build(A);
     m_coarseSpace.assemble(A, filter, m_tasks);
     applyTwoLevel(filter, r, z);
-    return;
+  } else {
+    applySymmetricGaussSeidel(filter, r, z);
   }
-  Vec3Array& w = m_product;
-  std::copy(r.begin(), r.end(), w.begin());
-  forwardSweep<false>(filter, m_direction, m_backward, w);  // w = P_L⁻¹ r
-  sumOverBlocks(vertexCount, [&](Index begin, Index end) {
-    return diagonalRange(begin, end, m_diagonal, filter, w, m_preconditioned);  // D̃ w
-  });
-  backwardSweep(filter, m_preconditioned, z, m_residual);  // z = P_U⁻¹ D̃ w
 }
 
 void FilteredPcg::prepareCouplings(const BlockSparseMatrix& A, const VertexFilter& filter) {
@@ -520,6 +513,9 @@ const Vec3Array* FilteredPcg::couplingProduct(const Vec3Array& x, bool offDiagon
 }
 
 Real FilteredPcg::addCouplingDiagonal(const VertexFilter& filter, const Vec3Array& r, Vec3Array& s) {
+  // The touched rows are the last solve's: without couplings now (applyPreconditioner) they are
+  // stale, and E adds nothing.
+  if (m_couplings.empty()) return 0;
   Real sum = 0;
   for (Index row : m_couplingRows) {
     const Vec3 extra = filter.filter(row, m_couplingDiagonal[row] * r[row]);
@@ -576,10 +572,7 @@ SolveReport FilteredPcg::solve(const BlockSparseMatrix& A, const Vec3Array& b,
   // The colouring and the aggregates depend on the pattern only: rebuilt (allocating) when the
   // topology changes. The coarse matrix is assembled and factorised every solve.
   if (gaussSeidel || twoLevel) prepareGaussSeidel(A);
-  if (twoLevel) {
-    if (!m_coarseSpace.built(A)) m_coarseSpace.build(A);
-    m_coarseSpace.assemble(A, filter, m_tasks);
-  }
+  if (twoLevel) m_coarseSpace.assemble(A, filter, m_tasks);
 
   // The velocity test's weights: m_i and 1/m_i on vertices with a free direction, zero on fixed
   // ones (and on a massless row, which a valid system does not have). Σm is the mass that moves.
@@ -705,20 +698,25 @@ bool FilteredPcg::Stopping::judge(Real stopDelta, Real residualDelta, Real solut
   return converged;
 }
 
-Real FilteredPcg::applyTwoLevel(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z) {
-  const Index vertexCount = Index(r.size());
+void FilteredPcg::applySymmetricGaussSeidel(const VertexFilter& filter, const Vec3Array& r,
+                                            Vec3Array& z) {
   Vec3Array& w = m_product;
   Vec3Array& y = m_backward;
   // w = P_L⁻¹ r and y = D̃ w in one pass, colour by colour.
   for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
     forEachBlock(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      twoLevelForwardRange(first + begin, first + end, m_lowerBlocks, m_ordering, filter,
-                           m_inverseDiagonal, m_diagonal, r, w, y);
+      forwardSweepWithDiagonalRange(first + begin, first + end, m_lowerBlocks, m_ordering, filter,
+                                    m_inverseDiagonal, m_diagonal, r, w, y);
     });
   }
   addCouplingDiagonal(filter, w, y);  // y = D̃' w
   backwardSweep(filter, y, z, w);     // z = P_U⁻¹ y; w is scratch
+}
+
+Real FilteredPcg::applyTwoLevel(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z) {
+  const Index vertexCount = Index(r.size());
+  applySymmetricGaussSeidel(filter, r, z);
   // The coarse correction's pass also sums rᵀz; without a factorised A_c, a pass of its own.
   if (m_coarseSpace.factorised()) return m_coarseSpace.addCorrection(filter, r, z, m_tasks);
   return sumOverBlocks(vertexCount, [&](Index begin, Index end) {

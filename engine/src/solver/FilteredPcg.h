@@ -328,6 +328,9 @@ class FilteredPcg {
                      const FilteredPcgPassSums& start, bool twoLevel, Vec3Array& deltaV,
                      SolveReport& report);
 
+  /// z = M_SGS⁻¹ r = P_U⁻¹ D̃' P_L⁻¹ r, the symmetric Gauss–Seidel preconditioner applied as such
+  /// (not in Eisenstat's form). Uses m_product and m_backward as scratch.
+  void applySymmetricGaussSeidel(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z);
   /// z = P⁻¹r for the two-level preconditioner (header, "Two-level"): symmetric Gauss–Seidel plus
   /// the coarse correction; returns rᵀz. Uses m_product and m_backward as scratch.
   Real applyTwoLevel(const VertexFilter& filter, const Vec3Array& r, Vec3Array& z);
