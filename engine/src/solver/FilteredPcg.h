@@ -40,7 +40,7 @@
 //   (weft-solver-compare, bench/results/solver-defaults.md).
 //   Rejected: natural-order Gauss–Seidel and block IC(0) (sequential sweeps: no parallel version
 //   with the same bits); over-relaxation (SSOR, ω > 1): with a multicolour order it saves no
-//   iterations (curtain ×1 and ×16: ω = 1.2–1.5 within ±5 % of ω = 1, worse beyond).
+//   iterations on the curtain (bench/results/two-level-pcg-2026-11-27.md).
 // - Two-level (PreconditionerKind::TwoLevelGaussSeidel, opt-in).
 //   Gauss–Seidel's iterations grow with the mesh's refinement (h²k/m grows with it): the smooth
 //   error, whole regions moving wrongly, falls slowly. The additive two-level preconditioner
