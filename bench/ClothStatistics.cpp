@@ -5,13 +5,15 @@
 
 namespace weft {
 
-StrainPercentiles strainPercentiles(const ClothModel& model, const Vec3Array& positions) {
-  std::vector<Real> strains;
-  strains.reserve(model.edges().size());
+void appendEdgeStrains(const ClothModel& model, const Vec3Array& positions,
+                       std::vector<Real>& strains) {
   for (const Edge& edge : model.edges()) {
     const Real length = (positions[edge.vertices[1]] - positions[edge.vertices[0]]).norm();
     strains.push_back(length / edge.restLength - 1);
   }
+}
+
+StrainPercentiles strainPercentiles(std::vector<Real>& strains) {
   std::sort(strains.begin(), strains.end());
   StrainPercentiles result{};
   if (strains.empty()) return result;
@@ -59,14 +61,26 @@ Silhouette SilhouetteGrid::rasterize(const std::vector<Index>& indices,
   return silhouette;
 }
 
-Real silhouetteDistance(const Silhouette& a, const Silhouette& b) {
-  if (a.covered.size() != b.covered.size()) return 1;
-  std::size_t both = 0, either = 0;
-  for (std::size_t k = 0; k < a.covered.size(); ++k) {
-    both += a.covered[k] & b.covered[k];
-    either += a.covered[k] | b.covered[k];
+void Coverage::add(const Silhouette& silhouette) {
+  if (fraction.empty()) fraction.assign(silhouette.covered.size(), 0);
+  if (fraction.size() != silhouette.covered.size()) return;
+  for (std::size_t k = 0; k < fraction.size(); ++k) fraction[k] += silhouette.covered[k];
+  ++outlines;
+}
+
+void Coverage::finish() {
+  if (outlines == 0) return;
+  for (Real& value : fraction) value /= Real(outlines);
+}
+
+Real coverageDistance(const Coverage& a, const Coverage& b) {
+  if (a.fraction.size() != b.fraction.size()) return 1;
+  Real difference = 0, either = 0;
+  for (std::size_t k = 0; k < a.fraction.size(); ++k) {
+    difference += std::abs(a.fraction[k] - b.fraction[k]);
+    either += std::max(a.fraction[k], b.fraction[k]);
   }
-  return either == 0 ? 0 : 1 - Real(both) / Real(either);
+  return either == 0 ? 0 : difference / either;
 }
 
 }  // namespace weft

@@ -1,7 +1,9 @@
-// ClothStatistics: shape statistics of a cloth state that converge where its trajectory does
-// not (folded, self-contacting cloth is chaotic: two accurate runs fold differently, but their
-// strain distribution and outline agree). Used by weft-error-time to rank phases whose vertex
-// distances the reference cannot resolve.
+// ClothStatistics: shape statistics that converge where a trajectory does not. Where the cloth's
+// motion is chaotic (a push that makes the hem flutter, folds in self-contact) two accurate runs
+// part, and so do their states at any one instant; what they share is the distribution over a
+// stretch of time: the strains of every edge at every sample pooled, and how often each point of
+// the outline is covered. Used by weft-error-time to rank phases whose vertex distances the
+// reference cannot resolve.
 #pragma once
 
 #include <weft/Math.h>
@@ -16,8 +18,12 @@ namespace weft {
 /// Percentiles of the mesh edges' strain l / l_rest − 1: 50 %, 90 %, 99 % and the largest.
 using StrainPercentiles = std::array<Real, 4>;
 
-/// The edge-strain percentiles of `positions` on `model`'s edges.
-StrainPercentiles strainPercentiles(const ClothModel& model, const Vec3Array& positions);
+/// The strains of `model`'s edges at `positions`, appended to `strains`.
+void appendEdgeStrains(const ClothModel& model, const Vec3Array& positions,
+                       std::vector<Real>& strains);
+
+/// The percentiles of `strains` (sorts them): of one state's edges, or of several states pooled.
+StrainPercentiles strainPercentiles(std::vector<Real>& strains);
 
 /// The cloth's outline seen along the view axis: a raster of the cells its triangles cover.
 struct Silhouette {
@@ -37,7 +43,19 @@ struct SilhouetteGrid {
   Silhouette rasterize(const std::vector<Index>& indices, const Vec3Array& positions) const;
 };
 
-/// 1 − |a ∩ b| / |a ∪ b|: 0 for the same outline, 1 for disjoint ones.
-Real silhouetteDistance(const Silhouette& a, const Silhouette& b);
+/// How often each cell of a grid is covered over several outlines: the fraction per cell.
+struct Coverage {
+  std::vector<Real> fraction;  ///< in [0, 1], per cell
+  Index outlines = 0;          ///< outlines added
+
+  /// Counts one outline of the grid.
+  void add(const Silhouette& silhouette);
+  /// Turns the counts into fractions (call once, after the last add()).
+  void finish();
+};
+
+/// Σ |a − b| / Σ max(a, b) over the cells (the weighted Jaccard distance): 1 − IoU for single
+/// outlines, 0 for the same coverage, 1 for disjoint ones.
+Real coverageDistance(const Coverage& a, const Coverage& b);
 
 }  // namespace weft

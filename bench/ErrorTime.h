@@ -27,8 +27,8 @@ struct ErrorTimeOptions {
   int repeats = 1;                ///< runs per configuration; the least CPU time is kept
   bool progress = true;           ///< one line per run while sweeping
   bool bullet = true;             ///< Bullet's soft body on the front (when built with Bullet)
-  /// Exit with status 3 when SolverSettings{} is dominated by more than the timing noise in a
-  /// phase the reference resolves (the defaults-on-the-front check).
+  /// Exit with status 3 when SolverSettings{} is dominated by more than the timing noise by a run
+  /// whose error the reference tells apart from theirs (the defaults-on-the-front check).
   bool checkDefaults = false;
   /// Runs only the configurations whose description contains this text (e.g. "h=1/60 "), and
   /// always SolverSettings{}; empty = every configuration of the grid.

@@ -40,8 +40,8 @@ int main(int argc, char** argv) {
   bool noBullet = false;
   app.add_flag("--no-bullet", noBullet, "Leave Bullet's points out");
   app.add_flag("--check-defaults", options.checkDefaults,
-               "Exit with status 3 when SolverSettings{} is dominated beyond the timing noise in a "
-               "phase the reference resolves");
+               "Exit with status 3 when SolverSettings{} is dominated beyond the timing noise by a "
+               "run whose error the reference tells apart (by vertex distance or statistics)");
   bool quiet = false;
   app.add_flag("--quiet", quiet, "No line per run");
   CLI11_PARSE(app, argc, argv);

@@ -228,6 +228,12 @@ void BulletCurtain::readPositions(Vec3Array& positions) const {
   for (int i = 0; i < cloth.m_nodes.size(); ++i) positions[std::size_t(i)] = fromBullet(cloth.m_nodes[i].m_x);
 }
 
+void BulletCurtain::readVelocities(Vec3Array& velocities) const {
+  const btSoftBody& cloth = *m_bullet->cloth;
+  velocities.resize(std::size_t(cloth.m_nodes.size()));
+  for (int i = 0; i < cloth.m_nodes.size(); ++i) velocities[std::size_t(i)] = fromBullet(cloth.m_nodes[i].m_v);
+}
+
 std::string BulletCurtain::describe() const {
   const btSoftBody& cloth = *m_bullet->cloth;
   std::ostringstream text;

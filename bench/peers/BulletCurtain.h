@@ -61,6 +61,8 @@ class BulletCurtain {
   void stepFrame();
   /// Current node positions, converted to double.
   void readPositions(Vec3Array& positions) const;
+  /// Current node velocities (m/s), converted to double.
+  void readVelocities(Vec3Array& velocities) const;
   /// Three node indices per face, from Bullet's own face list.
   const std::vector<Index>& indices() const { return m_indices; }
   /// The flat patch before the pleats: the rest state of every link.
