@@ -1,5 +1,5 @@
 // ClothStatistics: shape statistics that converge where a trajectory does not. Where the cloth's
-// motion is chaotic (a push that makes the hem flutter, folds in self-contact) two accurate runs
+// motion is chaotic (a free hem beside a pushing body, folds in self-contact) two accurate runs
 // part, and so do their states at any one instant; what they share is the distribution over a
 // stretch of time: the strains of every edge at every sample pooled, and how often each point of
 // the outline is covered. Used by weft-error-time to rank phases whose vertex distances the

@@ -24,7 +24,8 @@ struct ErrorTimeOptions {
   Index referenceSubsteps = 32;   ///< substeps per 1/60 s frame of the reference
   int referenceNewtonIterations = 2;  ///< Newton iterations per reference step
   Real referenceCgTolerance = 1e-10;  ///< PCG relative residual of the reference
-  int repeats = 1;                ///< runs per configuration; the least CPU time is kept
+  int repeats = 1;                ///< runs per configuration, in rounds over the grid; the least
+                                  ///< CPU time is kept
   bool progress = true;           ///< one line per run while sweeping
   bool bullet = true;             ///< Bullet's soft body on the front (when built with Bullet)
   /// Exit with status 3 when SolverSettings{} is dominated by more than the timing noise by a run

@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
                  "Newton iterations per reference step")
       ->check(CLI::Range(0, 10));
   app.add_option("--repeat", options.repeats,
-                 "Runs per configuration; the least CPU time is kept (errors are identical)")
+                 "Runs per configuration, in rounds over the whole grid; the least CPU time is "
+                 "kept (errors are identical)")
       ->check(CLI::Range(1, 20));
   app.add_option("--only", options.only,
                  "Run only the configurations whose description contains this text (the defaults "
