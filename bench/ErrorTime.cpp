@@ -916,7 +916,9 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
   // the machine's speed drifts over minutes, and a configuration's repeats run back to back
   // would share one slow spell. Each keeps its least CPU time.
   for (int round = 1; round < options.repeats; ++round) {
-    if (options.progress) out << "timing round " << round + 1 << " of " << options.repeats << "\n";
+    if (options.progress) {
+      out << "timing round " << round + 1 << " of " << options.repeats << "\n" << std::flush;
+    }
     for (RunResult& result : runs) {
       if (!result.stable) continue;
       std::vector<Sample> again;
