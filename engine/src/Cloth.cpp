@@ -397,8 +397,8 @@ bool Cloth::beginFrame(Real t, Real frameDt, const StepPlan& plan) {
     for (Vec3& start : m_pinStart) start = carry->apply(start);
     if (!carry->translationOnly()) {
       for (Vec3& v : m_velocities) v = carry->rotation * v;
-      m_integrator->rotateCarriedState(carry->rotation);
     }
+    m_integrator->carryCarriedState(*carry);
     teleported = true;
   }
   m_frameTolerance = plan.cgTolerance > 0 ? plan.cgTolerance : m_settings.solver.cgTolerance;

@@ -89,9 +89,13 @@ void Bdf2::restoreCarriedState(const Vec3Array& in) {
   }
 }
 
-void Bdf2::rotateCarriedState(const Mat3& rotation) {
-  m_implicit.rotateCarriedState(rotation);
-  m_hasHistory = false;
+void Bdf2::carryCarriedState(const RigidFit& motion) {
+  m_implicit.carryCarriedState(motion);
+  if (!motion.translationOnly()) {
+    m_hasHistory = false;
+    return;
+  }
+  for (Vec3& x : m_previousPosition) x = motion.apply(x);
 }
 
 }  // namespace weft

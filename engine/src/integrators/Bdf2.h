@@ -47,9 +47,10 @@ class Bdf2 final : public Integrator {
   void saveCarriedState(Vec3Array& out) const override;
   std::size_t carriedStateCapacity(std::size_t vertexCount) const override;
   void restoreCarriedState(const Vec3Array& in) override;
-  /// Turns the warm start; forgets the history, whose positions would need the motion's
-  /// translation too (a teleport's next step is a backward-Euler step).
-  void rotateCarriedState(const Mat3& rotation) override;
+  /// Carries the warm start and, for a translation, the history with the motion (the next step
+  /// goes on as if nothing happened); a turn forgets the history (gravity does not turn with
+  /// the cloth), so that teleport's next step is a backward-Euler step.
+  void carryCarriedState(const RigidFit& motion) override;
 
  private:
   ImplicitEuler m_implicit;

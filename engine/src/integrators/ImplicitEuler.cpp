@@ -41,9 +41,10 @@ void ImplicitEuler::restoreCarriedState(const Vec3Array& in) {
   m_hasWarmStart = true;
 }
 
-void ImplicitEuler::rotateCarriedState(const Mat3& rotation) {
-  if (!m_hasWarmStart) return;
-  for (Vec3& deltaV : m_deltaV) deltaV = rotation * deltaV;
+void ImplicitEuler::carryCarriedState(const RigidFit& motion) {
+  // The warm start is a velocity change: a translation leaves it as it is.
+  if (!m_hasWarmStart || motion.translationOnly()) return;
+  for (Vec3& deltaV : m_deltaV) deltaV = motion.rotation * deltaV;
 }
 
 void ImplicitEuler::resizeVertices(Index vertexCount) {

@@ -77,7 +77,7 @@ class ImplicitEuler final : public Integrator {
     return m_hasWarmStart ? std::span<const Vec3>(m_deltaV) : std::span<const Vec3>();
   }
   void restoreCarriedState(const Vec3Array& in) override;
-  void rotateCarriedState(const Mat3& rotation) override;
+  void carryCarriedState(const RigidFit& motion) override;
 
  private:
   void resizeVertices(Index vertexCount);

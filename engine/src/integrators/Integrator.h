@@ -7,6 +7,7 @@
 // at every stage, so every method can run every scene.
 #pragma once
 
+#include "RigidFit.h"
 #include "integrators/DynamicSystem.h"
 
 #include <weft/engine/SolverSettings.h>
@@ -62,9 +63,9 @@ class Integrator {
   }
   /// Restores what saveCarriedState() wrote (an empty array = no carried state).
   virtual void restoreCarriedState(const Vec3Array& in) { (void)in; reset(); }
-  /// Turns the carried state with a rigid motion of the whole system (a pin teleport that turns
-  /// the cloth): world-axis vectors are multiplied by `rotation`.
-  virtual void rotateCarriedState(const Mat3& rotation) { (void)rotation; }
+  /// Moves the carried state with a rigid motion of the whole system (a pin teleport): positions
+  /// as motion.apply() moves them, world-axis vectors turned by motion.rotation.
+  virtual void carryCarriedState(const RigidFit& motion) { (void)motion; }
 };
 
 /// Largest step h (s) at which `kind` keeps a damped linear mode ẍ = −ω² x − c ẋ from growing by
