@@ -65,6 +65,7 @@ void Coverage::add(const Silhouette& silhouette) {
   if (fraction.empty()) fraction.assign(silhouette.covered.size(), 0);
   if (fraction.size() != silhouette.covered.size()) return;
   for (std::size_t k = 0; k < fraction.size(); ++k) fraction[k] += silhouette.covered[k];
+  coveredCells += silhouette.coveredCells;
   ++outlines;
 }
 

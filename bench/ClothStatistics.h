@@ -47,6 +47,7 @@ struct SilhouetteGrid {
 struct Coverage {
   std::vector<Real> fraction;  ///< in [0, 1], per cell
   Index outlines = 0;          ///< outlines added
+  Index coveredCells = 0;      ///< covered cells, summed over the outlines added
 
   /// Counts one outline of the grid.
   void add(const Silhouette& silhouette);

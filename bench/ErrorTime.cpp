@@ -99,6 +99,7 @@ struct PhaseError {
 };
 
 constexpr const char* kStatisticNames[4] = {"energy", "strain", "contacts", "silhouette"};
+constexpr std::size_t kContactsStatistic = 2, kSilhouetteStatistic = 3;  // their indices
 
 struct RunResult {
   SweepConfig config;
@@ -940,12 +941,10 @@ int runErrorTime(const ErrorTimeOptions& options, std::ostream& out) {
           std::max(referenceErrors[p].statistics()[k], sensitivity[p].statistics()[k]);
     }
     const Real samplesInPhase = Real(phases[p].samples.size());
-    Real coveredCells = 0;  // over all the phase's samples of the reference
-    for (Real fraction : comparison.reference[p].coverage.fraction) {
-      coveredCells += fraction * samplesInPhase;
-    }
-    verdict.statisticsQuantum[2] = 1 / (Real(model->vertexCount()) * samplesInPhase);
-    verdict.statisticsQuantum[3] = coveredCells > 0 ? 1 / coveredCells : 0;
+    const Real coveredCells = Real(comparison.reference[p].coverage.coveredCells);
+    verdict.statisticsQuantum[kContactsStatistic] =
+        1 / (Real(model->vertexCount()) * samplesInPhase);
+    verdict.statisticsQuantum[kSilhouetteStatistic] = coveredCells > 0 ? 1 / coveredCells : 0;
     for (const RunResult& run : runs) {
       if (!run.stable || run.config.isBullet || p >= run.phases.size()) continue;
       const Real rms = run.phases[p].rms, statistics = verdict.statisticsInFloors(run.phases[p]);

@@ -39,6 +39,7 @@ TEST(ClothStatistics, OutlinesThatTakeTurnsHaveTheCoverageOfTheirMixture) {
   EXPECT_DOUBLE_EQ(coverageDistance(first, second), 0.0);
   ASSERT_EQ(first.fraction.size(), 2u);
   EXPECT_DOUBLE_EQ(first.fraction[0], 0.5);
+  EXPECT_EQ(first.coveredCells, 2u);  // one cell in each of the two outlines
   // Half the time against always: |½ − 1| / max(½, 1) per cell.
   const Coverage always = coverageOf({outline({1, 1}), outline({1, 1})});
   EXPECT_DOUBLE_EQ(coverageDistance(first, always), 0.5);

@@ -247,7 +247,7 @@ TEST(PinTeleport, PinsThatAllJumpCarryTheClothWhichGoesOnAsIfNothingHappened) {
 
 TEST(PinTeleport, ABdf2ClothCarriesItsHistoryWithItsPins) {
   // BDF2's step reads the previous step's positions: left behind, the 10 m jump would enter the
-  // next step as a velocity (31 m/s).
+  // next step as a velocity.
   ClothSettings settings = hangingCotton();
   settings.sleep.enabled = false;
   settings.solver.integrator = IntegratorKind::Bdf2;
