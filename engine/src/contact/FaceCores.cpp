@@ -13,6 +13,11 @@ namespace {
 // core) is pushed along its own normal: one nearly across the core, which pierces it.
 constexpr Real kLeastAcross = 0.5;
 
+// The start's core-to-face normal decides the side of a core over the face's interior when it
+// leans at least this far out of the face's plane (sine of the angle, 30°); nearer the plane its
+// component along the face's normal is a rounding's sign, not a side.
+constexpr Real kLeastStartLean = 0.5;
+
 // A mesh edge is a core of reach kMeshEdgeReach · allowance where a face could reach it between
 // its corners: where the surface round it bulges more than kMeshEdgeClearance · allowance into
 // a face of the face's extent. Elsewhere a face whose corners keep the allowance stays twice the
@@ -105,10 +110,16 @@ int facePoints(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, const 
     if (low <= high) {
       const Real ends[2] = {low, high};
       const bool line = high > low && segment.squaredNorm() > 0;
+      // The side the face must end on (+1: above the core along up). The start's normal tells it
+      // when it leans out of the face's plane (a face that crossed the core goes back); one
+      // nearly in the plane (the face came from beside the core) does not, and each core point
+      // then keeps the face on the side it is on now, as without a start.
+      const Real startLean = cameFrom.isZero() ? 0 : cameFrom.dot(up) / cameFrom.norm();
+      const Real startSide = std::abs(startLean) < kLeastStartLean ? 0 : (startLean > 0 ? 1 : -1);
       for (int k = 0; k < (line ? 2 : 1); ++k) {
         const Vec3 corePoint = core.start + ends[k] * segment;
         const Real height = up.dot(corePoint - a);  // of the core point over the face's plane
-        Real side = cameFrom.isZero() ? 0 : (cameFrom.dot(up) > 0 ? 1 : -1);
+        Real side = startSide;
         if (side == 0) side = height < 0 ? 1 : (height > 0 ? -1 : 0);
         if (side == 0) continue;  // on the face, with no start to tell the side
         const Vec3 onPlane = corePoint - height * up;

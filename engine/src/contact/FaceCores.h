@@ -31,7 +31,11 @@
 // body infinitely heavy).
 //
 // Which side: a face that crossed a core within the substep goes back to the side it came from,
-// the normal of the closest points at the substep start in the body's start frame.
+// the normal of the closest points at the substep start in the body's start frame. Over the
+// face's interior that normal decides only when it leans out of the face's plane: a face that
+// came from beside a core (a box's vertical edge beside a sheet squeezed under the box) has no
+// side along its normal to go back to, and is kept on the side each core point is on, not sent
+// the length of the core to its far end.
 #pragma once
 
 #include <weft/Math.h>
