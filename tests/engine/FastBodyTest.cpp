@@ -57,26 +57,44 @@ TEST_P(FastSphere, DoesNotPassThroughASheetPinnedOnItsEdges) {
   test::IntersectionCounter counter(world, {cloth});
   test::StepHealth health;
   const Index middle = (kSide / 2) * kSide + kSide / 2;
+  std::string broken;  // the first frame that breaks a condition, and how
+  auto check = [&](bool holds, int frame, const char* what) {
+    if (!holds && broken.empty()) broken = "frame " + std::to_string(frame) + ": " + what;
+  };
   // Until the sphere is 2 m past the sheet's plane.
   const int frames = int(std::ceil(3.0 / (speed * kFrame)));
   for (int frame = 0; frame < frames; ++frame) {
     health(world.step(kFrame));
-    ASSERT_GE(test::closestApproach(world, cloth, sphere), 0.0) << "a vertex inside, frame " << frame;
-    ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
+    check(test::closestApproach(world, cloth, sphere) >= 0, frame, "a vertex inside");
+    check(counter.count(world) == 0, frame, "intersecting triangle pairs");
     const Real sphereZ = motion(*world.collider(sphere).value()).pose.position.z();
     const Vec3& x = world.positions(cloth).value()[middle];
     // Pinned above and below, or all round, the middle is held across the sphere's path and must
     // stay ahead of it; pinned at the top only, it may be swept off over the top, never through.
     if (edges != PinnedEdges::Top || std::abs(x.y() - 1.0) < 0.1) {
-    ASSERT_GT(x.z(), sphereZ) << "the middle behind the sphere, frame " << frame;
+      check(x.z() > sphereZ, frame, "the middle behind the sphere");
     }
   }
   health.expectHealthy("fast sphere");
+  // At 20, 30, 40 and 77 m/s the sphere goes through the sheet (known failure; 50 m/s, 100,
+  // 250 and the sheet hanging from its top at 40 pass): stretched over it to strain 7-20 the sheet tents on one vertex with no face
+  // contact, and that vertex slides off the sphere's front (30 m/s, pinned all round: frame 4).
+  const bool known = (speed >= 20 && speed <= 77 && speed != 50) &&
+                     !(speed == 40 && edges == PinnedEdges::Top);
+  if (known) {
+    test::knownEngineFailure(broken.empty(), "a sphere at " + std::to_string(int(speed)) +
+                                                 " m/s does not pass through the sheet",
+                             broken + ": the sheet, stretched over the sphere to strain 7-20, "
+                                      "tents on one vertex with no face contact and slides off");
+    return;
+  }
+  EXPECT_TRUE(broken.empty()) << broken;
 }
 
 INSTANTIATE_TEST_SUITE_P(
     SpeedsAndPins, FastSphere,
-    ::testing::Combine(::testing::Values(Real(50), Real(100), Real(250)),
+    ::testing::Combine(::testing::Values(Real(20), Real(30), Real(40), Real(50), Real(77),
+                                         Real(100), Real(250)),
                        ::testing::Values(PinnedEdges::Four, PinnedEdges::TopAndBottom,
                                          PinnedEdges::Top)),
     [](const auto& info) {
