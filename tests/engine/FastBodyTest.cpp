@@ -76,16 +76,21 @@ TEST_P(FastSphere, DoesNotPassThroughASheetPinnedOnItsEdges) {
     }
   }
   health.expectHealthy("fast sphere");
-  // At 20, 30, 40 and 77 m/s the sphere goes through the sheet (known failure; 50 m/s, 100,
-  // 250 and the sheet hanging from its top at 40 pass): stretched over it to strain 7-20 the sheet tents on one vertex with no face
-  // contact, and that vertex slides off the sphere's front (30 m/s, pinned all round: frame 4).
+  // At 20, 30, 40 and 77 m/s the sphere goes through the sheet (known failure; 50 m/s, 100, 250
+  // and the sheet hanging from its top at 40 pass): stretched over it to strain 7-20 the sheet
+  // tents on one vertex with no face contact, and that vertex slides off the sphere's front
+  // (30 m/s, pinned all round: frame 4). The detection culls a face by its world-space path
+  // against the body's box at its end pose, which a body faster than its size per substep has
+  // left: culled by its path relative to the body, these cases pass, but at 250 m/s the face
+  // contacts then drag the sheet 3 m within one substep and the frame is retried.
   const bool known = (speed >= 20 && speed <= 77 && speed != 50) &&
                      !(speed == 40 && edges == PinnedEdges::Top);
   if (known) {
     test::knownEngineFailure(broken.empty(), "a sphere at " + std::to_string(int(speed)) +
                                                  " m/s does not pass through the sheet",
                              broken + ": the sheet, stretched over the sphere to strain 7-20, "
-                                      "tents on one vertex with no face contact and slides off");
+                                      "tents on one vertex with no face contact (faces are culled "
+                                      "against the body's end pose only) and slides off");
     return;
   }
   EXPECT_TRUE(broken.empty()) << broken;
