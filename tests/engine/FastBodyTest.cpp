@@ -1,7 +1,8 @@
-// Bodies faster than a frame can see and bodies that close on the cloth: a 10 cm sphere at up to
-// 250 m/s (4.2 m a frame) through a 1 m sheet pinned on four, two or one of its edges, and two
-// bodies closing to a gap below the cloth's thickness. The sphere never passes through the sheet
-// and the squeezed cloth ends between the bodies, never inside one, and the frame says so.
+// Bodies faster than a frame can see and bodies that close on the cloth: a 10 cm sphere at 20 to
+// 250 m/s (up to 4.2 m a frame) through a 1 m sheet pinned on four, two or one of its edges, and
+// two bodies closing to a gap below the cloth's thickness. The sphere must never pass through the
+// sheet, and the squeezed cloth must end between the bodies, never inside one, the frame saying
+// so. Where the engine does not yet hold that, the cases are marked as known engine failures.
 #include "ContactTestSupport.h"
 #include "KnownEngineFailure.h"
 
@@ -57,22 +58,21 @@ TEST_P(FastSphere, DoesNotPassThroughASheetPinnedOnItsEdges) {
   test::IntersectionCounter counter(world, {cloth});
   test::StepHealth health;
   const Index middle = (kSide / 2) * kSide + kSide / 2;
-  std::string broken;  // the first frame that breaks a condition, and how
-  auto check = [&](bool holds, int frame, const char* what) {
-    if (!holds && broken.empty()) broken = "frame " + std::to_string(frame) + ": " + what;
-  };
+  std::string broken;  // the first frame the middle is behind the sphere
   // Until the sphere is 2 m past the sheet's plane.
   const int frames = int(std::ceil(3.0 / (speed * kFrame)));
   for (int frame = 0; frame < frames; ++frame) {
     health(world.step(kFrame));
-    check(test::closestApproach(world, cloth, sphere) >= 0, frame, "a vertex inside");
-    check(counter.count(world) == 0, frame, "intersecting triangle pairs");
+    ASSERT_GE(test::closestApproach(world, cloth, sphere), 0.0) << "a vertex inside, frame " << frame;
+    ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
     const Real sphereZ = motion(*world.collider(sphere).value()).pose.position.z();
     const Vec3& x = world.positions(cloth).value()[middle];
     // Pinned above and below, or all round, the middle is held across the sphere's path and must
     // stay ahead of it; pinned at the top only, it may be swept off over the top, never through.
     if (edges != PinnedEdges::Top || std::abs(x.y() - 1.0) < 0.1) {
-      check(x.z() > sphereZ, frame, "the middle behind the sphere");
+      if (!(x.z() > sphereZ) && broken.empty()) {
+        broken = "frame " + std::to_string(frame) + ": the middle behind the sphere";
+      }
     }
   }
   health.expectHealthy("fast sphere");
@@ -135,7 +135,7 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   test::IntersectionCounter counter(world, {cloth});
   test::StepHealth health;
   bool closed = false, flagged = false;
-  std::string broken;  // the first frame that breaks a condition, and how
+  std::string broken;  // the first frame with a vertex inside a body, and which
   auto check = [&](bool holds, int frame, const std::string& what) {
     if (!holds && broken.empty()) broken = "frame " + std::to_string(frame) + ": " + what;
   };
@@ -161,19 +161,23 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
         motion(*world.collider(top).value()).pose.position.y() - pressHalf.y();
     const bool squeezed = hasFlag(status, StepStatus::Squeezed);
     const bool asleep = world.stats().sleepingCloths > 0;
-    check(pressBottom < 0.006 || !squeezed, frame, "flagged squeezed with the press far");
-    check(!(pressBottom < 0.006 && !asleep && (shape == Press::Box || !flagged)) || squeezed, frame,
-          "not flagged squeezed with the press " + std::to_string(pressBottom) + " m up");
+    if (pressBottom >= 0.006) {
+      EXPECT_FALSE(squeezed) << "frame " << frame;
+    }
+    if (pressBottom < 0.006 && !asleep && (shape == Press::Box || !flagged)) {
+      EXPECT_TRUE(squeezed) << "frame " << frame << ", the press " << pressBottom << " m up";
+    }
     flagged = flagged || squeezed;
-    check((world.stats().squeezedVertices > 0) == squeezed, frame, "squeezed vertices unflagged");
+    EXPECT_EQ(world.stats().squeezedVertices > 0, squeezed) << "frame " << frame;
     check(test::closestApproach(world, cloth, floor) >= 0, frame, "inside the floor");
     check(test::closestApproach(world, cloth, top) >= 0, frame, "inside the press");
-    check(counter.count(world) == 0, frame, "intersecting triangle pairs");
+    ASSERT_EQ(counter.count(world), 0u) << "intersecting triangle pairs, frame " << frame;
   }
   ASSERT_TRUE(closed);
   // The middle vertex is held in the gap.
   const Vec3& middle = world.positions(cloth).value()[(kSide / 2) * kSide + kSide / 2];
-  check(middle.y() >= 0 && middle.y() <= gap, 90, "the middle vertex out of the gap");
+  EXPECT_GE(middle.y(), 0.0);
+  EXPECT_LE(middle.y(), gap);
   health.expectHealthy("squeeze");
   if (shape == Press::Box) {
     test::knownEngineFailure(
