@@ -175,6 +175,15 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
   // substeps are automatic and the retry can help (strainRetryHelps): the contacts of a squeeze
   // move cloth several thicknesses a substep at 60 Hz, more than one projection can untangle.
   const Index strainRetryCap = strainRetryLimit(cloths, plan);
+  // A retry starts where the frame started: the cloths, and the face supports the last frame
+  // left for this one's first solve.
+  m_frameStartSupports = m_supports;
+  auto restoreFrameStart = [&] {
+    for (std::size_t c = 0; c < cloths.size(); ++c) {
+      if (m_stepping[c]) cloths[c]->restoreFrameStart();
+    }
+    m_supports = m_frameStartSupports;
+  };
   for (int attempt = 0;; ++attempt) {
     StepStats attemptStats;
     HealthFailure failure = runSubsteps(t, frameDt, substeps, attemptStats);
@@ -190,9 +199,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
     }
     if (failure == HealthFailure::None && substeps * 2 <= strainRetryCap &&
         strainRetryHelps(cloths)) {
-      for (std::size_t c = 0; c < cloths.size(); ++c) {
-        if (m_stepping[c]) cloths[c]->restoreFrameStart();
-      }
+      restoreFrameStart();
       ++stats.strainRetries;
       substeps *= 2;
       --attempt;  // not a health retry: the doubling itself bounds these
@@ -204,9 +211,7 @@ void SubstepPipeline::stepFrame(std::span<Cloth* const> cloths,
       break;
     }
     if (stats.healthFailure == HealthFailure::None) stats.healthFailure = failure;
-    for (std::size_t c = 0; c < cloths.size(); ++c) {
-      if (m_stepping[c]) cloths[c]->restoreFrameStart();
-    }
+    restoreFrameStart();
     stats.status |= StepStatus::Unstable;
     if (attempt == kMaxHealthRetries) {
       stats.status |= StepStatus::RolledBack;

@@ -86,6 +86,7 @@ class SubstepPipeline {
   ContactSet m_contacts;
   std::vector<SolveConstraint> m_constraints;
   std::vector<FaceSupport> m_supports;
+  std::vector<FaceSupport> m_frameStartSupports;  // restored with the cloths for a retry
   std::vector<ColliderFrame> m_colliders;        // this substep's
   std::vector<ColliderFrame> m_frameColliders;   // at the frame start (sleep decisions)
   std::vector<RigidMotion> m_frameStartMotions;
