@@ -265,14 +265,19 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
           space.inverseMass[corner[2]] == 0) {
         continue;
       }
-      // Start and end: a face may cross a thin body within one substep. With the margin: the
-      // projection may move a face that far towards the body.
+      // The face's path relative to the body, against the body at its end pose: its start
+      // carried with the body, and its end. A face may cross a thin body within one substep, and
+      // a fast body may cross a face that barely moves (its box at the end pose alone is then
+      // far from the face). With the margin: the projection may move a face that far towards
+      // the body; with the bulge: a turning body's relative paths are arcs.
       Aabb box = Aabb::empty();
+      Real bulge = 0;
       for (Index i : corner) {
         box.expand(space.x[i]);
-        box.expand(space.startX[i]);
+        box.expand(collider.carry(space.startX[i]));
+        bulge = std::max(bulge, pathBulge(collider, space.startX[i], space.x[i]));
       }
-      box.inflate(margin);
+      box.inflate(margin + bulge);
       if (!box.overlaps(body)) continue;
       const Real allowance = thicknessOf(space, corner[0]);
       m_bodyCores.clear();
