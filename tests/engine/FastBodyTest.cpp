@@ -112,7 +112,8 @@ TEST(FastSphere, AFrameRetriedWithMoreSubstepsEndsAsOneRunWithThemFromItsStart) 
   StepStatus retried, direct;
   const std::uint64_t afterRetry = run(0, retried);
   const std::uint64_t twoSubsteps = run(2, direct);
-  ASSERT_TRUE(hasFlag(retried, StepStatus::RetriedWithSmallerStep)) << describe(retried);
+  ASSERT_TRUE(hasFlag(retried, StepStatus::RetriedWithSmallerStep))
+      << describe(retried) << ": the frame is no longer retried; this test needs another that is";
   EXPECT_FALSE(hasFlag(direct, StepStatus::RetriedWithSmallerStep)) << describe(direct);
   EXPECT_EQ(afterRetry, twoSubsteps);
 }
