@@ -172,6 +172,13 @@ Real pathBulge(const ColliderFrame& collider, const Vec3& start, const Vec3& end
   return 0.125 * (turn * turn * std::max(u0.norm(), u1.norm()) + 2 * turn * (u1 - u0).norm());
 }
 
+void addRelativePath(const ColliderFrame& collider, const Vec3& start, const Vec3& end, Aabb& box,
+                     Real& bulge) {
+  box.expand(collider.carry(start));
+  box.expand(end);
+  bulge = std::max(bulge, pathBulge(collider, start, end));
+}
+
 Vec3 keepOutside(const ColliderFrame& collider, const Vec3& start, const Vec3& end, Real thickness,
                  bool* sweptHit) {
   if (collider.turn() == 0) {

@@ -80,6 +80,13 @@ std::optional<PathContact> firstContactAlong(const ColliderFrame& collider, cons
 /// from the box of carry(start) and `end` (zero for a body that does not turn).
 Real pathBulge(const ColliderFrame& collider, const Vec3& start, const Vec3& end);
 
+/// Adds to `box` the path relative to the body, in its end frame, of a point moving from `start`
+/// to `end` (the start carried with the body, and the end), and raises `bulge` (m) to how far
+/// that path, an arc for a turning body, strays from its chord: inflated by `bulge`, the box
+/// holds every point of the path.
+void addRelativePath(const ColliderFrame& collider, const Vec3& start, const Vec3& end, Aabb& box,
+                     Real& bulge);
+
 /// Where a vertex moving from `start` to `end` over the substep ends without passing through the
 /// collider or ending within its thickness: the path relative to the body stops where it first
 /// meets the surface and slides on without the inward part of its velocity relative to the body

@@ -62,8 +62,7 @@ void ContactDetector::selectNear(const ContactSpace& space,
       Real bulge = 0;
       for (Index i = 0; i < space.vertexCount(); ++i) {
         if (space.inverseMass[i] == 0) continue;
-        box.expand(collider.carry(space.startX[i]));
-        bulge = std::max(bulge, pathBulge(collider, space.startX[i], end[i]));
+        addRelativePath(collider, space.startX[i], end[i], box, bulge);
       }
       box.inflate(bulge);
     }
@@ -272,11 +271,7 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
       // the body; with the bulge: a turning body's relative paths are arcs.
       Aabb box = Aabb::empty();
       Real bulge = 0;
-      for (Index i : corner) {
-        box.expand(space.x[i]);
-        box.expand(collider.carry(space.startX[i]));
-        bulge = std::max(bulge, pathBulge(collider, space.startX[i], space.x[i]));
-      }
+      for (Index i : corner) addRelativePath(collider, space.startX[i], space.x[i], box, bulge);
       box.inflate(margin + bulge);
       if (!box.overlaps(body)) continue;
       const Real allowance = thicknessOf(space, corner[0]);

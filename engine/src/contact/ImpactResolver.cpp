@@ -73,8 +73,7 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
       Real bulge = 0;
       for (Index i = 0; i < space.vertexCount(); ++i) {
         if (space.inverseMass[i] == 0) continue;
-        box.expand(colliders[k].carry(space.startX[i]));
-        bulge = std::max(bulge, pathBulge(colliders[k], space.startX[i], space.x[i]));
+        addRelativePath(colliders[k], space.startX[i], space.x[i], box, bulge);
       }
       box.inflate(bulge);
     }
