@@ -27,6 +27,10 @@ constexpr int kFrictionSweeps = std::numeric_limits<int>::max();
 // each correction by mass, which lets a load from the far side (a body pushing the cloth's middle)
 // draw cloth in from the pins.
 constexpr int kFollowTheLeaderSweeps = 1;
+// The sweep from which the projector tries listing the edges left to visit instead of scanning
+// every edge (VisitSet.h), and tries again at every power of two after while too many are left:
+// most projections end sooner, and a try costs about one scan.
+constexpr int kTrackingFromSweep = 4;
 // m: face points closer than this outside their reach still count as touching (a point the
 // projection just put at the reach is at −1e-17).
 constexpr Real kTouching = 1e-9;
@@ -108,6 +112,7 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   }
   m_moves.assign(space.vertexCount(), 0);
   m_edgeSeenMoves.assign(space.edges.size(), std::numeric_limits<std::uint64_t>::max());
+  m_trackingEdges = false;
   m_solved = space.x;
   m_touching.assign(space.vertexCount(), 0);
   m_surfaceNormal.assign(space.vertexCount(), Vec3::Zero());
@@ -124,6 +129,9 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
     m_pairMass[c] = pairInverseMass(set.contacts[c], space.inverseMass);
   }
   for (int iteration = 0;; ++iteration) {
+    if (!m_trackingEdges && iteration >= kTrackingFromSweep && (iteration & (iteration - 1)) == 0) {
+      startTracking(space);
+    }
     const bool backward = iteration % 2 == 1;
     m_frictionOn = iteration < kFrictionSweeps;
     m_followTheLeader = iteration < kFollowTheLeaderSweeps;
@@ -152,6 +160,33 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   for (Index i = 0; i < space.vertexCount(); ++i) space.v[i] += (space.x[i] - m_solved[i]) * inverseStep;
   report.colliderContacts = finish(space, set, colliders, supports);
   return report;
+}
+
+void ContactProjector::startTracking(ContactSpace& space) {
+  // The edges a full sweep would not skip. Tracked once at most half of them are: where most
+  // edges move every sweep, listing them costs more than the scan it saves.
+  const Index edgeCount = Index(space.edges.size());
+  const bool ordered = space.edgeOrder.size() == space.edges.size();
+  m_pendingEdges.reset(edgeCount, false);
+  Index pending = 0;
+  for (Index slot = 0; slot < edgeCount; ++slot) {
+    const Index e = ordered ? space.edgeOrder[slot] : slot;
+    const std::uint64_t moves = std::uint64_t(m_moves[space.edges[e][0]]) + m_moves[space.edges[e][1]];
+    if (moves != m_edgeSeenMoves[e]) {
+      m_pendingEdges.insert(slot);
+      ++pending;
+    }
+  }
+  if (2 * pending > edgeCount) return;
+  // The table is the space's; a space put together by hand (tests) gets it here.
+  if (space.edgeSlotBegin.size() != std::size_t(space.vertexCount()) + 1 ||
+      space.edgeSlots.size() != 2 * space.edges.size()) {
+    space.listEdgeSlots();
+  }
+  m_edgeSlotBegin = space.edgeSlotBegin;
+  m_edgeSlots = space.edgeSlots;
+  m_edgesPending.assign(space.vertexCount(), 0);
+  m_trackingEdges = true;
 }
 
 Index ContactProjector::unseparatedContacts(const ContactSpace& space, const ContactSet& set,
@@ -194,15 +229,34 @@ std::uint64_t ContactProjector::movesOf(const Contact& contact) const {
   return moves;
 }
 
-void ContactProjector::markIfWithin(const ContactSpace& space, Index e) {
+void ContactProjector::markIfWithin(const ContactSpace& space, Index e, Index slot) {
   const Index a = space.edges[e][0], b = space.edges[e][1];
   // Measured as the sweep measures it: a correction can leave the edge a rounding error long.
   if ((space.x[b] - space.x[a]).norm() <= space.longest[e]) {
     m_edgeSeenMoves[e] = std::uint64_t(m_moves[a]) + m_moves[b];
+    if (m_trackingEdges) settle(slot, a, b);
   }
 }
 
+void ContactProjector::listEdgesOf(Index vertex) {
+  for (Index k = m_edgeSlotBegin[vertex]; k < m_edgeSlotBegin[vertex + 1]; ++k) {
+    m_pendingEdges.insert(m_edgeSlots[k]);
+  }
+  m_edgesPending[vertex] = 1;
+}
+
+void ContactProjector::settle(Index slot, Index a, Index b) {
+  m_pendingEdges.erase(slot);
+  m_edgesPending[a] = m_edgesPending[b] = 0;
+}
+
 Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool backward) {
+  return m_trackingEdges ? sweepEdgesAs<true>(space, tolerance, backward)
+                         : sweepEdgesAs<false>(space, tolerance, backward);
+}
+
+template <bool tracking>
+Index ContactProjector::sweepEdgesAs(ContactSpace& space, Real tolerance, bool backward) {
   const Index edgeCount = Index(space.edges.size());
   Index over = 0;
   // The tethers first: each moves its vertex only (the anchor is a pin).
@@ -217,27 +271,46 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
     over += length > longest * (1 + tolerance);
     const Vec3 shift = ((longest - length) / length) * delta;
     space.x[i] += shift;
-    m_moves[i] += shift != Vec3::Zero();
+    moved(i, shift != Vec3::Zero());
   }
   const bool ordered = space.edgeOrder.size() == space.edges.size();
   const bool anchored = space.anchorDistance.size() == space.x.size() && m_followTheLeader;
-  for (Index k = 0; k < edgeCount; ++k) {
-    const Index slot = backward ? edgeCount - 1 - k : k;
+  // The next edge in sweep order; once tracking, those settled since their last visit left out.
+  const auto following = [&](Index slot) {
+    if constexpr (tracking) {
+      return backward ? (slot == 0 ? kInvalidIndex : m_pendingEdges.previous(slot - 1))
+                      : m_pendingEdges.next(slot + 1);
+    } else {
+      return backward ? slot - 1 : (slot + 1 < edgeCount ? slot + 1 : kInvalidIndex);
+    }
+  };
+  Index first = backward ? edgeCount - 1 : 0;  // kInvalidIndex (no edges) when backward
+  if constexpr (tracking) {
+    first = backward ? m_pendingEdges.previous(first) : m_pendingEdges.next(first);
+  } else if (edgeCount == 0) {
+    first = kInvalidIndex;
+  }
+  for (Index slot = first; slot != kInvalidIndex; slot = following(slot)) {
     const Index e = ordered ? space.edgeOrder[slot] : slot;
     const Index a = space.edges[e][0], b = space.edges[e][1];
     // Left within its limit at its last visit, and neither end moved since: still within it.
     const std::uint64_t moves = std::uint64_t(m_moves[a]) + m_moves[b];
-    if (moves == m_edgeSeenMoves[e]) continue;
+    if (moves == m_edgeSeenMoves[e]) {
+      if constexpr (tracking) settle(slot, a, b);
+      continue;
+    }
     const Real longest = space.longest[e];
     const Vec3 delta = space.x[b] - space.x[a];
     const Real length = delta.norm();
     if (!(length > longest)) {
       m_edgeSeenMoves[e] = moves;
+      if constexpr (tracking) settle(slot, a, b);
       continue;
     }
     Real weightA = space.inverseMass[a], weightB = space.inverseMass[b];
     if (weightA + weightB == 0) {  // both ends pinned: nothing can shorten it
       m_edgeSeenMoves[e] = moves;
+      if constexpr (tracking) settle(slot, a, b);
       continue;
     }
     over += length > longest + tolerance * space.restLengths[e];
@@ -257,9 +330,9 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
       const Real fraction = heldStepFraction(delta, shiftB - shiftA, longest);
       space.x[a] += fraction * shiftA;
       space.x[b] += fraction * shiftB;
-      m_moves[a] += fraction * shiftA != Vec3::Zero();
-      m_moves[b] += fraction * shiftB != Vec3::Zero();
-      markIfWithin(space, e);
+      moved(a, fraction * shiftA != Vec3::Zero());
+      moved(b, fraction * shiftB != Vec3::Zero());
+      markIfWithin(space, e, slot);
       continue;
     }
     // Follow the leader: the end nearer the pins stays, unless the other cannot move or either
@@ -272,9 +345,9 @@ Index ContactProjector::sweepEdges(ContactSpace& space, Real tolerance, bool bac
     const Vec3 impulse = ((length - longest) / ((weightA + weightB) * length)) * delta;
     space.x[a] += weightA * impulse;
     space.x[b] -= weightB * impulse;
-    m_moves[a] += weightA > 0;
-    m_moves[b] += weightB > 0;
-    markIfWithin(space, e);
+    moved(a, weightA > 0);
+    moved(b, weightB > 0);
+    markIfWithin(space, e, slot);
   }
   return over;
 }
@@ -338,7 +411,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
       shift = outside - x;
       depth = std::max<Real>(thickness - before.distance, shift.norm());
       x = outside;
-      ++m_moves[i];
+      moved(i);
     }
   }
   m_lastOutside[index] = x;
@@ -357,7 +430,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   applied -= applied.dot(on.normal) * on.normal;
   const Vec3 correction = frictionCorrection(slip, applied, normal, contact.friction);
   x += correction - applied;
-  m_moves[i] += correction != applied;
+  moved(i, correction != applied);
   m_friction[index] = correction;
   return std::max(depth, (correction - applied).norm());
 }
@@ -370,7 +443,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
                                  space.inverseMass, space.x, space.v, 0, normal);
   m_pushed[index] += depth;
   if (depth > 0) {
-    for (Index i : corner) ++m_moves[i];
+    for (Index i : corner) moved(i);
   }
   if (!m_frictionOn || !contact.resting || !(contact.friction > 0)) return depth;
   // Friction at the face's centroid over the corners that are not on the body themselves (those
@@ -420,7 +493,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
   const Vec3 change = correction - applied;
   for (int j = 0; j < 3; ++j) {
     space.x[corner[j]] += (b[j] * space.inverseMass[corner[j]] / weight) * change;
-    m_moves[corner[j]] += b[j] != 0 && change != Vec3::Zero();
+    moved(corner[j], b[j] != 0 && change != Vec3::Zero());
   }
   m_friction[index] = correction;
   return std::max(depth, change.norm());
@@ -439,7 +512,7 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
       if (space.inverseMass[i] == 0) continue;
       const Vec3 shift = (contact.weights[k] * inverseMass) * lambda;
       space.x[i] += shift;
-      m_moves[i] += shift != Vec3::Zero();
+      moved(i, shift != Vec3::Zero());
     }
   };
   if (shortfall > 0) {

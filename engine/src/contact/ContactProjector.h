@@ -22,7 +22,10 @@
 //    on the next sweep and converge at m_light / m_heavy per iteration).
 // An edge left within its limit whose ends have not moved since (each vertex counts its moves)
 // is skipped, which changes nothing (its correction would be none): the late sweeps, where a few
-// edges are still converging, measure only the edges near them. A contact whose last visit moved
+// edges are still converging, measure only the edges near them. Once at most half the edges are
+// left to visit (tried from the fourth sweep), a sweep walks the set of them (VisitSet) that the
+// moves keep up to date, instead of testing every edge: the same visits in the same order, at a
+// cost that follows the edges still converging, not the cloth. A contact whose last visit moved
 // none of its vertices is skipped alike until one of them moves.
 // Every position change Δx is made as the velocity change Δx / h too, so v stays the substep's
 // average velocity. Sweeps alternate direction; the iteration stops when no edge is over its
@@ -54,6 +57,7 @@
 #include "contact/ContactSet.h"
 #include "contact/ContactDetector.h"
 #include "contact/ContactSpace.h"
+#include "contact/VisitSet.h"
 
 #include <cstdint>
 #include <span>
@@ -94,14 +98,28 @@ class ContactProjector {
   // One Gauss–Seidel sweep over the edges over their limit; returns how many were over
   // limit + tolerance before their correction.
   Index sweepEdges(ContactSpace& space, Real tolerance, bool backward);
+  template <bool tracking>
+  Index sweepEdgesAs(ContactSpace& space, Real tolerance, bool backward);
   // The contacts of `set` short of their separation by more than `shortfall` thicknesses,
   // measured without correcting.
   Index unseparatedContacts(const ContactSpace& space, const ContactSet& set,
                             std::span<const ColliderFrame> colliders, Real shortfall) const;
   // Σ m_moves over the contact's vertices.
   std::uint64_t movesOf(const Contact& contact) const;
-  // Marks edge e as seen within its limit when it is (sweepEdges skips it until an end moves).
-  void markIfWithin(const ContactSpace& space, Index e);
+  // Marks edge e (at sweep position `slot`) as seen within its limit when it is (sweepEdges skips
+  // it until an end moves).
+  void markIfWithin(const ContactSpace& space, Index e, Index slot);
+  // Counts a move of `vertex` and, once tracking, puts its edges back into the edge sweeps (a
+  // vertex moved again and again lists them once, until one of them settles).
+  void moved(Index vertex, bool did = true) {
+    m_moves[vertex] += did;
+    if (did && m_trackingEdges && !m_edgesPending[vertex]) listEdgesOf(vertex);
+  }
+  void listEdgesOf(Index vertex);
+  // Takes the edge at sweep position `slot`, between vertices a and b, off the pending edges.
+  void settle(Index slot, Index a, Index b);
+  // From the next sweep on, the edge sweeps visit only the pending edges, if few enough are.
+  void startTracking(ContactSpace& space);
   // One sweep over the contacts; returns how many were violated beyond tolerance.
   Index sweepContacts(ContactSpace& space, const ContactSet& set,
                       std::span<const ColliderFrame> colliders, Real h, Real tolerance,
@@ -130,6 +148,12 @@ class ContactProjector {
   std::vector<std::uint8_t> m_colliderContactsOf;  // per vertex: its vertex–collider contacts, 2 meaning more
   std::vector<std::uint32_t> m_moves;  // per vertex: how many times the projection moved it
   std::vector<std::uint64_t> m_edgeSeenMoves;  // per edge: its ends' m_moves after its last visit
+  // The edges (by sweep position) the next edge sweeps must visit: those not seen within their
+  // limit since an end last moved. Visiting only these is the same sweep as visiting all.
+  VisitSet m_pendingEdges;
+  bool m_trackingEdges = false;      // the edge sweeps walk m_pendingEdges, or every edge
+  std::vector<char> m_edgesPending;  // per vertex: every edge of it is in m_pendingEdges
+  std::span<const Index> m_edgeSlotBegin, m_edgeSlots;  // the space's (ContactSpace::edgeSlots)
   Vec3Array m_surfaceNormal;      // per vertex: the collider surface it rests on, zero if none
   Vec3Array m_solved;             // the positions the projection started from (the solve's)
 };

@@ -30,6 +30,8 @@ void ContactSpace::build(std::span<Cloth* const> cloths) {
   tetherLength.clear();
   anchorDistance.clear();
   edgeOrder.clear();
+  edgeSlotBegin.clear();
+  edgeSlots.clear();
   m_faceContacts.clear();
   for (std::size_t c = 0; c < m_cloths.size(); ++c) {
     const Cloth& cloth = *m_cloths[c];
@@ -78,8 +80,24 @@ void ContactSpace::build(std::span<Cloth* const> cloths) {
   };
   std::stable_sort(edgeOrder.begin(), edgeOrder.end(),
                    [&](Index a, Index b) { return nearer(a) < nearer(b); });
+  listEdgeSlots();
   startX = x;
   startV = v;
+}
+
+void ContactSpace::listEdgeSlots() {
+  const bool ordered = edgeOrder.size() == edges.size();
+  edgeSlotBegin.assign(x.size() + 1, 0);
+  for (const std::array<Index, 2>& edge : edges) {
+    ++edgeSlotBegin[edge[0] + 1];
+    ++edgeSlotBegin[edge[1] + 1];
+  }
+  for (std::size_t i = 0; i < x.size(); ++i) edgeSlotBegin[i + 1] += edgeSlotBegin[i];
+  edgeSlots.resize(2 * edges.size());
+  std::vector<Index> fill(edgeSlotBegin.begin(), edgeSlotBegin.end() - 1);
+  for (Index slot = 0; slot < Index(edges.size()); ++slot) {
+    for (Index vertex : edges[ordered ? edgeOrder[slot] : slot]) edgeSlots[fill[vertex]++] = slot;
+  }
 }
 
 void ContactSpace::setMovable(std::size_t cloth, bool movable) {

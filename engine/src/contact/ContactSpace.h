@@ -91,6 +91,12 @@ class ContactSpace {
   /// The edges in the order the projector sweeps them: by the anchor distance of their nearer
   /// end, then by index (nearest the pins first).
   std::vector<Index> edgeOrder;
+  /// Per vertex, the positions in edgeOrder of its edges (the positions are the edges' indices
+  /// when edgeOrder is empty): those of vertex i are edgeSlots[edgeSlotBegin[i],
+  /// edgeSlotBegin[i + 1]), the edges a move of the vertex may take over their limit.
+  std::vector<Index> edgeSlotBegin, edgeSlots;
+  /// Builds edgeSlotBegin and edgeSlots from edges and edgeOrder (build() does; allocates).
+  void listEdgeSlots();
 
   /// Marks whether a cloth's faces are kept out of colliders (ClothSettings::faceContacts).
   bool faceContacts(Index vertex) const {
