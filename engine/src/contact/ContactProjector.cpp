@@ -185,6 +185,9 @@ void ContactProjector::startTracking(ContactSpace& space) {
   }
   m_edgeSlotBegin = space.edgeSlotBegin;
   m_edgeSlots = space.edgeSlots;
+  // Every tether once more in the first tracked sweep, as in an untracked one.
+  m_tethered = std::min<Index>(space.vertexCount(), Index(space.tetherAnchor.size()));
+  m_pendingTethers.reset(m_tethered, true);
   m_edgesPending.assign(space.vertexCount(), 0);
   m_trackingEdges = true;
 }
@@ -242,6 +245,7 @@ void ContactProjector::listEdgesOf(Index vertex) {
   for (Index k = m_edgeSlotBegin[vertex]; k < m_edgeSlotBegin[vertex + 1]; ++k) {
     m_pendingEdges.insert(m_edgeSlots[k]);
   }
+  if (vertex < m_tethered) m_pendingTethers.insert(vertex);
   m_edgesPending[vertex] = 1;
 }
 
@@ -259,19 +263,32 @@ template <bool tracking>
 Index ContactProjector::sweepEdgesAs(ContactSpace& space, Real tolerance, bool backward) {
   const Index edgeCount = Index(space.edges.size());
   Index over = 0;
-  // The tethers first: each moves its vertex only (the anchor is a pin).
+  // The tethers first: each moves its vertex only (the anchor is a pin, which the projection
+  // never moves). Once tracking, only the vertices moved since their tether was last within.
   const Index tethered = std::min<Index>(space.vertexCount(), Index(space.tetherAnchor.size()));
-  for (Index i = 0; i < tethered; ++i) {
+  Index i = 0;
+  if constexpr (tracking) i = m_pendingTethers.next(0);
+  while (i < tethered) {
     const Index anchor = space.tetherAnchor[i];
-    if (anchor == kInvalidIndex || space.inverseMass[i] == 0) continue;
-    const Vec3 delta = space.x[i] - space.x[anchor];
+    const Vec3 delta = space.x[i] - space.x[anchor == kInvalidIndex ? i : anchor];
     const Real length = delta.norm();
     const Real longest = space.tetherLength[i];
-    if (!(length > longest)) continue;
-    over += length > longest * (1 + tolerance);
-    const Vec3 shift = ((longest - length) / length) * delta;
-    space.x[i] += shift;
-    moved(i, shift != Vec3::Zero());
+    if (anchor == kInvalidIndex || space.inverseMass[i] == 0 || !(length > longest)) {
+      if constexpr (tracking) {
+        m_pendingTethers.erase(i);
+        m_edgesPending[i] = 0;  // its next move lists the tether again
+      }
+    } else {
+      over += length > longest * (1 + tolerance);
+      const Vec3 shift = ((longest - length) / length) * delta;
+      space.x[i] += shift;
+      moved(i, shift != Vec3::Zero());
+    }
+    if constexpr (tracking) {
+      i = m_pendingTethers.next(i + 1);
+    } else {
+      ++i;
+    }
   }
   const bool ordered = space.edgeOrder.size() == space.edges.size();
   const bool anchored = space.anchorDistance.size() == space.x.size() && m_followTheLeader;

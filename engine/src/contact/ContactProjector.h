@@ -109,8 +109,8 @@ class ContactProjector {
   // Marks edge e (at sweep position `slot`) as seen within its limit when it is (sweepEdges skips
   // it until an end moves).
   void markIfWithin(const ContactSpace& space, Index e, Index slot);
-  // Counts a move of `vertex` and, once tracking, puts its edges back into the edge sweeps (a
-  // vertex moved again and again lists them once, until one of them settles).
+  // Counts a move of `vertex` and, once tracking, puts its edges and its tether back into the edge
+  // sweeps (a vertex moved again and again lists them once, until one of them settles).
   void moved(Index vertex, bool did = true) {
     m_moves[vertex] += did;
     if (did && m_trackingEdges && !m_edgesPending[vertex]) listEdgesOf(vertex);
@@ -151,8 +151,12 @@ class ContactProjector {
   // The edges (by sweep position) the next edge sweeps must visit: those not seen within their
   // limit since an end last moved. Visiting only these is the same sweep as visiting all.
   VisitSet m_pendingEdges;
-  bool m_trackingEdges = false;      // the edge sweeps walk m_pendingEdges, or every edge
-  std::vector<char> m_edgesPending;  // per vertex: every edge of it is in m_pendingEdges
+  // The vertices whose tether the next edge sweep must test: those moved since it was within.
+  VisitSet m_pendingTethers;
+  Index m_tethered = 0;              // vertices with a tether entry (ContactSpace::tetherAnchor)
+  bool m_trackingEdges = false;      // the edge sweeps walk the pending sets, or every edge
+  // Per vertex: every edge of it is in m_pendingEdges, and it is in m_pendingTethers.
+  std::vector<char> m_edgesPending;
   std::span<const Index> m_edgeSlotBegin, m_edgeSlots;  // the space's (ContactSpace::edgeSlots)
   Vec3Array m_surfaceNormal;      // per vertex: the collider surface it rests on, zero if none
   Vec3Array m_solved;             // the positions the projection started from (the solve's)
