@@ -62,8 +62,10 @@ TEST_P(FastSphere, DoesNotPassThroughASheetPinnedOnItsEdges) {
   test::StepHealth health;
   const Index middle = (kSide / 2) * kSide + kSide / 2;
   std::string broken;  // the frame the middle went through the sphere
-  // The middle's distance from the line the sphere's centre travels (the z axis through it).
-  const auto offAxis = [&](const Vec3& x) { return std::hypot(x.x(), x.y() - 1.0); };
+  // The middle's distance from the line the sphere's centre travels (along z).
+  const auto offAxis = [&](const Vec3& x) {
+    return std::hypot(x.x() - projectile.pose.position.x(), x.y() - projectile.pose.position.y());
+  };
   bool ahead = true;
   Real lastOffAxis = offAxis(world.positions(cloth).value()[middle]);
   // Until the sphere is 2 m past the sheet's plane.
@@ -115,7 +117,7 @@ TEST(FastSphere, AFrameRetriedWithMoreSubstepsEndsAsOneRunWithThemFromItsStart) 
     RigidMotion projectile;
     projectile.pose.position = Vec3(0, 1.0, -1.0);
     projectile.linearVelocity = Vec3(0, 0, 250);
-    (void)world.addCollider(Sphere::create(0.1, projectile).value()).value();
+    (void)world.addCollider(Sphere::create(kSphereRadius, projectile).value()).value();
     status = world.step(kFrame);
     return world.stateHash();
   };

@@ -270,10 +270,11 @@ Index ContactProjector::sweepEdgesAs(ContactSpace& space, Real tolerance, bool b
   if constexpr (tracking) i = m_pendingTethers.next(0);
   while (i < tethered) {
     const Index anchor = space.tetherAnchor[i];
-    const Vec3 delta = space.x[i] - space.x[anchor == kInvalidIndex ? i : anchor];
-    const Real length = delta.norm();
+    const bool tethers = anchor != kInvalidIndex && space.inverseMass[i] != 0;
+    const Vec3 delta = tethers ? Vec3(space.x[i] - space.x[anchor]) : Vec3::Zero();
+    const Real length = tethers ? delta.norm() : Real(0);
     const Real longest = space.tetherLength[i];
-    if (anchor == kInvalidIndex || space.inverseMass[i] == 0 || !(length > longest)) {
+    if (!tethers || !(length > longest)) {
       if constexpr (tracking) {
         m_pendingTethers.erase(i);
         m_edgesPending[i] = 0;  // its next move lists the tether again
