@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <variant>
 
 namespace weft {
@@ -192,11 +193,14 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
                                              std::span<const Index> constrainedCollider,
                                              Real margin, ContactSet& set,
                                              DetectionCounts& counts) {
+  m_vertexContacts.resize(space.vertexCount() + 1);
   for (Index i = 0; i < space.vertexCount(); ++i) {
+    m_vertexContacts[i] = set.contacts.size();
     if (space.inverseMass[i] == 0) continue;
     const Real thickness = thicknessOf(space, i);
     const Real friction = space.owners[space.owner[i]].friction;
     const std::size_t first = set.contacts.size();
+    m_surfaceNormals.clear();
     for (Index k : m_near) {
       const ColliderFrame& collider = colliders[k];
       const Vec3 start = collider.carry(space.startX[i]);
@@ -213,6 +217,7 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
       contact.kind = ContactKind::VertexCollider;
       contact.vertices[0] = i;
       contact.normal = hit ? hit->normal : end->normal;
+      m_surfaceNormals.push_back(end->normal);
       contact.separation = thickness;
       contact.gap = end->distance;
       contact.friction = std::sqrt(std::max<Real>(0, collider.friction) * friction);
@@ -232,8 +237,14 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
       for (std::size_t b = a + 1; b < set.contacts.size(); ++b) {
         Contact& one = set.contacts[a];
         Contact& other = set.contacts[b];
-        if (!(one.normal.dot(other.normal) < kOpposedNormals)) continue;
-        const Real room = one.gap + other.gap;
+        Real room = one.gap + other.gap;
+        if (!(one.normal.dot(other.normal) < kOpposedNormals)) {
+          // The normals of the contacts need not face each other where the vertex came in
+          // through a side (under a press's edge): the bodies' surfaces may still do, across it.
+          const Vec3& x = space.x[i];
+          room = std::min(roomAcross(colliders, x, one, m_surfaceNormals[a - first], other),
+                          roomAcross(colliders, x, other, m_surfaceNormals[b - first], one));
+        }
         if (!(room < one.separation + other.separation)) continue;
         const Real half = std::max<Real>(0, room / 2);
         one.separation = std::min(one.separation, half);
@@ -243,6 +254,7 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
     }
     counts.squeezedVertices += squeezed;
   }
+  m_vertexContacts[space.vertexCount()] = set.contacts.size();
 }
 
 void ContactDetector::detectColliderFaces(const ContactSpace& space,
@@ -328,7 +340,53 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
           }
         }
         set.cores.push_back(core);
+        if (before.distance > 0) {
+          squeezeFace(colliders, contact, endPose.toWorld(before.pointOnSegment),
+                      endPose.rotation * contact.normal, set);
+        }
         set.contacts.push_back(contact);
+      }
+    }
+  }
+}
+
+Real ContactDetector::roomAcross(std::span<const ColliderFrame> colliders, const Vec3& x,
+                                 const Contact& from, const Vec3& surfaceNormal,
+                                 const Contact& to) {
+  // From the point of `from`'s body nearest the vertex, across to `to`'s body: the room between
+  // them when `to`'s surface there faces `from`'s back.
+  const Vec3 surfacePoint = x - from.gap * surfaceNormal;
+  const ShapeContact across = queryPoint(colliders[to.collider].shape, surfacePoint);
+  if (!(across.normal.dot(surfaceNormal) < kOpposedNormals)) {
+    return std::numeric_limits<Real>::infinity();
+  }
+  return across.distance;
+}
+
+void ContactDetector::squeezeFace(std::span<const ColliderFrame> colliders, const Contact& face,
+                                  const Vec3& corePoint, const Vec3& normal,
+                                  ContactSet& set) const {
+  // A face lies between the core and another body when the core point is outside that body,
+  // within twice the reach, and the body's normal there meets the core-to-face direction head on
+  // (a press's edge over a sheet on a floor). The face then has only their distance: it keeps
+  // half of it from the core, and its corners half of it from the body, as squeezed vertices do;
+  // a corner kept its thickness from the body would hold the face up into the core. A core point
+  // inside the other body (capsules overlapping in a ring) has no face between them.
+  FaceCore& core = set.cores[face.core];
+  for (Index j : m_near) {
+    if (j == face.collider) continue;
+    const ShapeContact other = queryPoint(colliders[j].shape, corePoint);
+    if (!(other.distance > 0 && other.distance < 2 * core.reach) ||
+        !(other.normal.dot(normal) < kOpposedNormals)) {
+      continue;
+    }
+    const Real half = other.distance / 2;
+    core.reach = std::min(core.reach, half);
+    for (int k = 0; k < 3; ++k) {
+      const Index corner = face.vertices[k];
+      for (std::size_t c = m_vertexContacts[corner]; c < m_vertexContacts[corner + 1]; ++c) {
+        Contact& contact = set.contacts[c];
+        if (contact.collider == j) contact.separation = std::min(contact.separation, half);
       }
     }
   }

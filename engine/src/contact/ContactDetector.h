@@ -11,6 +11,9 @@
 //    a vertex the projection moves towards the body);
 //  - face–collider: faces whose path reaches a core of a body thinner than the triangles
 //    (FaceCores.h);
+//  - squeezes: where two bodies close on a vertex, or a core and another body on a face, to less
+//    than the distances their contacts keep, each contact keeps half the room between the bodies
+//    instead, and the cloth is held midway (StepStatus::Squeezed);
 //  - vertex–face and edge–edge pairs, within a cloth and between cloths: one broad phase over
 //    the swept boxes (FeaturePairs), the closest points at both ends, a pair closer than its
 //    thickness at either end being a contact (Bridson, Fedkiw & Anderson 2002, §7.2). The weights
@@ -108,6 +111,16 @@ class ContactDetector {
                            std::span<const Real> solveImpulses,
                            std::span<const Index> constrainedCollider, Real margin,
                            ContactSet& set);
+  // The room (m) between the body of contact `from` (`surfaceNormal`: its normal at the point
+  // nearest vertex position `x`) and that of `to`, across from that point; infinite when `to`'s
+  // surface there does not face it back.
+  static Real roomAcross(std::span<const ColliderFrame> colliders, const Vec3& x,
+                         const Contact& from, const Vec3& surfaceNormal, const Contact& to);
+  // Where another body faces the face of contact `face` back across it, within twice its core's
+  // reach of the core point (`corePoint` and `normal`, core to face, world): gives the face and
+  // its corners' contacts with that body half the room between the two.
+  void squeezeFace(std::span<const ColliderFrame> colliders, const Contact& face,
+                   const Vec3& corePoint, const Vec3& normal, ContactSet& set) const;
   void detectPairs(const ContactSpace& space, ContactSet& set);
   // The colliders whose box comes near the cloth's motion, into m_near; counts both kinds.
   void selectNear(const ContactSpace& space, std::span<const ColliderFrame> colliders,
@@ -118,6 +131,8 @@ class ContactDetector {
   Real m_pairMargin = 0;  // of the last detectPairs()
   FeaturePairs m_features;
   std::vector<Index> m_near;  // colliders near the cloth this pass
+  std::vector<std::size_t> m_vertexContacts;  // per vertex + 1: its first collider contact
+  std::vector<Vec3> m_surfaceNormals;  // the current vertex's contacts: the bodies' normals at it
   OrderedPairFilter<Contact> m_pairFilter;
   std::vector<Index> m_meshTriangles;
   std::vector<Index> m_meshEdges;
