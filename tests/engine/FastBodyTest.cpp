@@ -11,10 +11,12 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <string>
 #include <tuple>
+#include <vector>
 
 namespace weft {
 namespace {
@@ -142,7 +144,19 @@ INSTANTIATE_TEST_SUITE_P(
              name(std::get<1>(info.param));
     });
 
-enum class Press { Box, Sphere };
+enum class Press { Box, MeshBox, Sphere };
+
+// A box of half extents `half` as a closed triangle mesh (12 triangles, wound outwards).
+TriangleMeshShape boxMesh(const Vec3& half, const RigidMotion& motion) {
+  std::vector<Vec3> corners;
+  for (int k = 0; k < 8; ++k) {
+    corners.emplace_back((k & 1) ? half.x() : -half.x(), (k & 2) ? half.y() : -half.y(),
+                         (k & 4) ? half.z() : -half.z());
+  }
+  const std::vector<Index> indices{0, 2, 1, 1, 2, 3,  4, 5, 6, 5, 7, 6,  0, 1, 4, 1, 5, 4,
+                                   2, 6, 3, 3, 6, 7,  0, 4, 2, 2, 4, 6,  1, 3, 5, 3, 7, 5};
+  return TriangleMeshShape::create(corners, indices, motion).value();
+}
 
 // The press and the gap (m) it stops at above the floor, below the cloth's 3 mm thickness.
 class Squeeze : public ::testing::TestWithParam<std::tuple<Press, Real>> {};
@@ -150,9 +164,10 @@ class Squeeze : public ::testing::TestWithParam<std::tuple<Press, Real>> {};
 TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   const auto [shape, gap] = GetParam();
   World world;
-  // A 0.6 m sheet lying on a box whose top is at y = 0; a box or a sphere comes down onto it at
-  // 0.5 m/s and stops `gap` above the box. Under the box's edges the sheet steps from the gap up
-  // to its thickness, so the box's edges, as face-contact cores, lie over the faces there.
+  // A 0.6 m sheet lying on a box whose top is at y = 0; a box (analytic, or a 12-triangle mesh)
+  // or a sphere comes down onto it at 0.5 m/s and stops `gap` above the box. Under the box's
+  // edges the sheet steps from the gap up to its thickness, so the box's edges, as face-contact
+  // cores, lie over the faces there.
   const Vec3 half(0.5, 0.1, 0.5);
   RigidMotion below;
   below.pose.position = Vec3(0, -half.y(), 0);
@@ -161,10 +176,14 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   RigidMotion press;
   press.pose.position = Vec3(0, 0.05 + pressHalf.y(), 0);
   press.linearVelocity = Vec3(0, -0.5, 0);
-  const ColliderId top =
-      shape == Press::Box
-          ? world.addCollider(Box::create(pressHalf, press).value()).value()
-          : world.addCollider(Sphere::create(pressHalf.y(), press).value()).value();
+  ColliderId top;
+  switch (shape) {
+    case Press::Box: top = world.addCollider(Box::create(pressHalf, press).value()).value(); break;
+    case Press::MeshBox: top = world.addCollider(boxMesh(pressHalf, press)).value(); break;
+    case Press::Sphere:
+      top = world.addCollider(Sphere::create(pressHalf.y(), press).value()).value();
+      break;
+  }
   // Cotton, with its strain limit: the press must neither tear the sheet out from between the
   // bodies nor stretch it past the limit.
   ClothSettings settings;
@@ -174,6 +193,8 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   test::IntersectionCounter counter(world, {cloth});
   test::StepHealth health;
   bool closed = false, flagged = false;
+  int unresolved = 0, overLimit = 0;  // frames with unresolved contacts, past the strain limit
+  Real worstStrain = 0;
   std::string broken;  // the first frame with a vertex inside a body, and which
   auto check = [&](bool holds, int frame, const std::string& what) {
     if (!holds && broken.empty()) broken = "frame " + std::to_string(frame) + ": " + what;
@@ -203,15 +224,13 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
     if (pressBottom >= 0.006) {
       EXPECT_FALSE(squeezed) << "frame " << frame;
     }
-    if (pressBottom < 0.006 && !asleep && (shape == Press::Box || !flagged)) {
+    if (pressBottom < 0.006 && !asleep && (shape != Press::Sphere || !flagged)) {
       EXPECT_TRUE(squeezed) << "frame " << frame << ", the press " << pressBottom << " m up";
     }
     flagged = flagged || squeezed;
-    // Room for each vertex and face exists at every gap: the projection finds it, within the
-    // strain limit.
-    EXPECT_FALSE(hasFlag(status, StepStatus::ContactsUnresolved)) << "frame " << frame;
-    EXPECT_FALSE(hasFlag(status, StepStatus::StrainLimitExceeded))
-        << "frame " << frame << ": strain " << world.stats().maxStrain;
+    unresolved += hasFlag(status, StepStatus::ContactsUnresolved);
+    overLimit += hasFlag(status, StepStatus::StrainLimitExceeded);
+    worstStrain = std::max(worstStrain, world.stats().maxStrain);
     EXPECT_EQ(world.stats().squeezedVertices > 0, squeezed) << "frame " << frame;
     check(test::closestApproach(world, cloth, floor) >= 0, frame, "inside the floor");
     check(test::closestApproach(world, cloth, top) >= 0, frame, "inside the press");
@@ -223,16 +242,35 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   EXPECT_GE(middle.y(), 0.0);
   EXPECT_LE(middle.y(), gap);
   health.expectHealthy("squeeze");
-  EXPECT_TRUE(broken.empty()) << broken;
+  // Room for each vertex and face exists at every gap: the projection finds it, within the strain
+  // limit, in every frame.
+  const bool held = broken.empty() && unresolved == 0 && overLimit == 0;
+  const std::string figures =
+      (broken.empty() ? std::string("outside both bodies") : broken) + "; " +
+      std::to_string(unresolved) + " frames with unresolved contacts, " +
+      std::to_string(overLimit) + " past the strain limit (largest " +
+      std::to_string(worstStrain) + ")";
+  if (shape == Press::MeshBox && gap < 0.001) {
+    test::knownEngineFailure(
+        held, "a sheet squeezed to 0.5 mm under a box modelled as a mesh rests, resolved",
+        figures + ". From frame 57 on, 3 or 4 contacts under the mesh's bottom edges end the "
+                  "projection (at its cap of 256 sweeps) short of their separation by more than a "
+                  "tenth of the thickness, the vertex and face contacts there pulling against "
+                  "each other by a few hundredths of a millimetre a sweep");
+    return;
+  }
+  EXPECT_TRUE(held) << figures;
 }
 
 INSTANTIATE_TEST_SUITE_P(
     Presses, Squeeze,
-    ::testing::Combine(::testing::Values(Press::Box, Press::Sphere),
+    ::testing::Combine(::testing::Values(Press::Box, Press::MeshBox, Press::Sphere),
                        ::testing::Values(Real(0.0005), Real(0.001), Real(0.0015), Real(0.002),
                                          Real(0.0025))),
     [](const auto& info) {
-      const char* press = std::get<0>(info.param) == Press::Box ? "Box" : "Sphere";
+      const Press shape = std::get<0>(info.param);
+      const char* press =
+          shape == Press::Box ? "Box" : shape == Press::MeshBox ? "MeshBox" : "Sphere";
       return std::string(press) + "To" +
              std::to_string(int(std::lround(10000 * std::get<1>(info.param)))) + "TenthsOfAMillimetre";
     });

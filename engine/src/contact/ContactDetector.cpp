@@ -342,7 +342,7 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
         set.cores.push_back(core);
         if (before.distance > 0) {
           squeezeFace(colliders, contact, endPose.toWorld(before.pointOnSegment),
-                      endPose.rotation * contact.normal, set);
+                      endPose.rotation * contact.normal, allowance, set);
         }
         set.contacts.push_back(contact);
       }
@@ -364,29 +364,37 @@ Real ContactDetector::roomAcross(std::span<const ColliderFrame> colliders, const
 }
 
 void ContactDetector::squeezeFace(std::span<const ColliderFrame> colliders, const Contact& face,
-                                  const Vec3& corePoint, const Vec3& normal,
+                                  const Vec3& corePoint, const Vec3& normal, Real thickness,
                                   ContactSet& set) const {
-  // A face lies between the core and another body when the core point is outside that body,
-  // within twice the reach, and the body's normal there meets the core-to-face direction head on
-  // (a press's edge over a sheet on a floor). The face then has only their distance: it keeps
-  // half of it from the core, and its corners half of it from the body, as squeezed vertices do;
-  // a corner kept its thickness from the body would hold the face up into the core. A core point
-  // inside the other body (capsules overlapping in a ring) has no face between them.
+  // A face lies between the core and another body when the core point is outside that body and
+  // the body's normal there meets the core-to-face direction head on (a press's edge over a sheet
+  // on a floor). The face keeps the core's reach from the core, and its corners the thickness
+  // from the body: where the two are farther apart than their distance, each gives up the same
+  // share, and so do the corners' contacts with the core's own body, as a squeezed vertex's two
+  // contacts do. A corner kept its thickness from either body would hold the face into the core
+  // or push it into the other body. A core point inside the other body (capsules overlapping in a
+  // ring) has no face between them.
   FaceCore& core = set.cores[face.core];
   for (Index j : m_near) {
     if (j == face.collider) continue;
     const ShapeContact other = queryPoint(colliders[j].shape, corePoint);
-    if (!(other.distance > 0 && other.distance < 2 * core.reach) ||
+    const Real wanted = core.reach + thickness;
+    if (!(other.distance > 0 && other.distance < wanted) ||
         !(other.normal.dot(normal) < kOpposedNormals)) {
       continue;
     }
-    const Real half = other.distance / 2;
-    core.reach = std::min(core.reach, half);
+    const Real share = other.distance / wanted;
+    core.reach *= share;
+    // A corner may slide anywhere under the core's body, where the two are as near: it keeps no
+    // more than half their distance from either.
+    const Real corners = std::min(share * thickness, other.distance / 2);
     for (int k = 0; k < 3; ++k) {
       const Index corner = face.vertices[k];
       for (std::size_t c = m_vertexContacts[corner]; c < m_vertexContacts[corner + 1]; ++c) {
         Contact& contact = set.contacts[c];
-        if (contact.collider == j) contact.separation = std::min(contact.separation, half);
+        if (contact.collider == j || contact.collider == face.collider) {
+          contact.separation = std::min(contact.separation, corners);
+        }
       }
     }
   }

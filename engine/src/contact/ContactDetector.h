@@ -116,11 +116,12 @@ class ContactDetector {
   // surface there does not face it back.
   static Real roomAcross(std::span<const ColliderFrame> colliders, const Vec3& x,
                          const Contact& from, const Vec3& surfaceNormal, const Contact& to);
-  // Where another body faces the face of contact `face` back across it, within twice its core's
-  // reach of the core point (`corePoint` and `normal`, core to face, world): gives the face and
-  // its corners' contacts with that body half the room between the two.
+  // Where another body faces the face of contact `face` back across it, nearer the core point
+  // (`corePoint` and `normal`, core to face, world) than the core's reach and the `thickness` its
+  // corners keep: shortens the reach, and the corners' separations from both bodies, to fit.
   void squeezeFace(std::span<const ColliderFrame> colliders, const Contact& face,
-                   const Vec3& corePoint, const Vec3& normal, ContactSet& set) const;
+                   const Vec3& corePoint, const Vec3& normal, Real thickness,
+                   ContactSet& set) const;
   void detectPairs(const ContactSpace& space, ContactSet& set);
   // The colliders whose box comes near the cloth's motion, into m_near; counts both kinds.
   void selectNear(const ContactSpace& space, std::span<const ColliderFrame> colliders,

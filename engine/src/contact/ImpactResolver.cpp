@@ -103,20 +103,7 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
   }
   // Then the faces on bodies thinner than the triangles, which have the last word: a vertex
   // pushed out of one capsule of a ring may tilt its face into the next.
-  for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
-    Real deepest = 0;
-    for (std::size_t c = 0; c < set.firstPair; ++c) {
-      const Contact& contact = set.contacts[c];
-      if (contact.kind != ContactKind::FaceCollider) continue;
-      Vec3 normal;
-      deepest = std::max(deepest, pushFaceOut(set.cores[contact.core], contact.normal,
-                                              colliders[contact.collider].end.pose,
-                                              {contact.vertices[0], contact.vertices[1],
-                                               contact.vertices[2]},
-                                              space.inverseMass, space.x, space.v, 0, normal));
-    }
-    if (!(deepest > kSettledDepth)) break;
-  }
+  pushFacesOut(set, space.inverseMass, space.x, space.v, 0, false);
   return corrected;
 }
 
@@ -158,31 +145,52 @@ void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
   // The faces on a body thinner than the triangles, whose corners an impulse moved: a face an
   // impulse pushed into a core goes back out to its reach, as a velocity change of its corners.
   if (m_set == nullptr) return;
-  bool endsKnown = false;
+  for (Index i = 0; i < space.vertexCount(); ++i) m_end[i] = space.startX[i] + h * m_velocity[i];
+  pushFacesOut(*m_set, space.inverseMass, m_end, m_velocity, 1 / h, true);
+}
+
+void ImpactResolver::pushFacesOut(const ContactSet& set, std::span<const Real> inverseMasses,
+                                  std::span<Vec3> x, std::span<Vec3> v, Real inverseStep,
+                                  bool touchedOnly) {
+  bool pushed = false;
   for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
     Real deepest = 0;
-    for (std::size_t c = 0; c < m_set->firstPair; ++c) {
-      const Contact& contact = m_set->contacts[c];
+    for (std::size_t c = 0; c < set.firstPair; ++c) {
+      const Contact& contact = set.contacts[c];
       if (contact.kind != ContactKind::FaceCollider) continue;
       const std::array<Index, 3> corner{contact.vertices[0], contact.vertices[1],
                                         contact.vertices[2]};
-      if (!m_touched[corner[0]] && !m_touched[corner[1]] && !m_touched[corner[2]]) continue;
-      if (!endsKnown) {
-        for (Index i = 0; i < space.vertexCount(); ++i) {
-          m_end[i] = space.startX[i] + h * m_velocity[i];
-        }
-        endsKnown = true;
+      if (touchedOnly && !m_touched[corner[0]] && !m_touched[corner[1]] && !m_touched[corner[2]]) {
+        continue;
+      }
+      if (!pushed) {
+        m_beforeFaces.assign(x.begin(), x.end());
+        pushed = true;
       }
       Vec3 normal;
-      const Real depth = pushFaceOut(m_set->cores[contact.core], contact.normal,
-                                     m_colliders[contact.collider].end.pose, corner,
-                                     space.inverseMass, m_end, m_velocity, 1 / h, normal);
-      if (depth > 0) {
+      const Real depth =
+          pushFaceOut(set.cores[contact.core], contact.normal,
+                      m_colliders[contact.collider].end.pose, corner, inverseMasses, x, v,
+                      inverseStep, normal);
+      if (touchedOnly && depth > 0) {
         for (Index i : corner) m_touched[i] = 1;
       }
       deepest = std::max(deepest, depth);
     }
     if (!(deepest > kSettledDepth)) break;
+  }
+  if (!pushed) return;
+  // A face pushed off a core may press a corner into a body beside it (a sheet under the edge
+  // of a press, the floor beneath): the corner stops on that body's surface, on its way from
+  // where it was before the faces moved it, which is outside.
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (x[i] == m_beforeFaces[i]) continue;
+    for (Index k : m_near) {
+      const Vec3 outside =
+          keepOutsideFrom(m_colliders[k].shape, m_beforeFaces[i], x[i], kDefaultContactTolerance);
+      v[i] += inverseStep * (outside - x[i]);
+      x[i] = outside;
+    }
   }
 }
 

@@ -95,6 +95,11 @@ class ImpactResolver {
   void rigidifyZones(const ContactSpace& space);
   Real impulseInverseMass(Index vertex, const ContactSpace& space);
   void clampToColliders(const ContactSpace& space, Real h);
+  // Sweeps of the face contacts on thin bodies over positions `x` (shifts also made as velocity
+  // changes × inverseStep in `v`); `touchedOnly`: faces with a corner in m_touched, which the
+  // pushes extend. A corner pushed into a body stops on its surface.
+  void pushFacesOut(const ContactSet& set, std::span<const Real> inverseMasses, std::span<Vec3> x,
+                    std::span<Vec3> v, Real inverseStep, bool touchedOnly);
   // Marks in m_farMover the vertices whose ends moved too far from the detection's for its
   // feature pairs to hold theirs; returns how many.
   Index markFarMovers();
@@ -122,6 +127,7 @@ class ImpactResolver {
   Vec3Array m_projected;                     // x as the projection left it
   std::vector<char> m_tracked;               // per vertex: in a collider contact of the set
   std::vector<Real> m_colliderSeparation;    // per vertex: how far it is kept from a body (m)
+  Vec3Array m_beforeFaces;                   // x before the face sweeps
   std::vector<signed char> m_held;           // per vertex: −1 unknown, 0 free, 1 held
   std::vector<Index> m_zoneParent;           // union–find over vertices
   std::vector<char> m_inZone;
