@@ -12,8 +12,8 @@
 //  - face–collider: faces whose path reaches a core of a body thinner than the triangles
 //    (FaceCores.h);
 //  - squeezes: where two bodies close on a vertex, or a core and another body on a face, to less
-//    than the distances their contacts keep, each contact keeps half the room between the bodies
-//    instead, and the cloth is held midway (StepStatus::Squeezed);
+//    than the distances its contacts keep, those shrink to share the room between the bodies
+//    (half each for a vertex), and the cloth is held between them (StepStatus::Squeezed);
 //  - vertex–face and edge–edge pairs, within a cloth and between cloths: one broad phase over
 //    the swept boxes (FeaturePairs), the closest points at both ends, a pair closer than its
 //    thickness at either end being a contact (Bridson, Fedkiw & Anderson 2002, §7.2). The weights

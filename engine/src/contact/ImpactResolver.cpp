@@ -58,6 +58,8 @@ void ImpactResolver::build(const ContactSpace& space, TaskSystem* tasks) {
   m_velocity.resize(n);
   m_end.resize(n);
   m_testedEnd.resize(n);
+  m_beforeFaces.resize(n);
+  m_faceCorner.assign(n, 0);
 }
 
 Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& set,
@@ -144,7 +146,7 @@ void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
   }
   // The faces on a body thinner than the triangles, whose corners an impulse moved: a face an
   // impulse pushed into a core goes back out to its reach, as a velocity change of its corners.
-  if (m_set == nullptr) return;
+  if (m_set == nullptr || !m_faceContacts) return;
   for (Index i = 0; i < space.vertexCount(); ++i) m_end[i] = space.startX[i] + h * m_velocity[i];
   pushFacesOut(*m_set, space.inverseMass, m_end, m_velocity, 1 / h, true);
 }
@@ -152,7 +154,7 @@ void ImpactResolver::clampToColliders(const ContactSpace& space, Real h) {
 void ImpactResolver::pushFacesOut(const ContactSet& set, std::span<const Real> inverseMasses,
                                   std::span<Vec3> x, std::span<Vec3> v, Real inverseStep,
                                   bool touchedOnly) {
-  bool pushed = false;
+  m_faceCorners.clear();
   for (int sweep = 0; sweep < kFaceSweeps; ++sweep) {
     Real deepest = 0;
     for (std::size_t c = 0; c < set.firstPair; ++c) {
@@ -163,9 +165,12 @@ void ImpactResolver::pushFacesOut(const ContactSet& set, std::span<const Real> i
       if (touchedOnly && !m_touched[corner[0]] && !m_touched[corner[1]] && !m_touched[corner[2]]) {
         continue;
       }
-      if (!pushed) {
-        m_beforeFaces.assign(x.begin(), x.end());
-        pushed = true;
+      // Where each corner was before the faces moved it (outside every body).
+      for (Index i : corner) {
+        if (m_faceCorner[i]) continue;
+        m_faceCorner[i] = 1;
+        m_faceCorners.push_back(i);
+        m_beforeFaces[i] = x[i];
       }
       Vec3 normal;
       const Real depth =
@@ -179,11 +184,11 @@ void ImpactResolver::pushFacesOut(const ContactSet& set, std::span<const Real> i
     }
     if (!(deepest > kSettledDepth)) break;
   }
-  if (!pushed) return;
   // A face pushed off a core may press a corner into a body beside it (a sheet under the edge
   // of a press, the floor beneath): the corner stops on that body's surface, on its way from
-  // where it was before the faces moved it, which is outside.
-  for (std::size_t i = 0; i < x.size(); ++i) {
+  // where it was before the faces moved it.
+  for (Index i : m_faceCorners) {
+    m_faceCorner[i] = 0;
     if (x[i] == m_beforeFaces[i]) continue;
     for (Index k : m_near) {
       const Vec3 outside =
@@ -447,6 +452,8 @@ ImpactReport ImpactResolver::resolve(ContactSpace& space, const ContactSet& set,
   ImpactReport report;
   m_colliders = colliders;
   m_set = &set;
+  m_faceContacts = std::any_of(set.contacts.begin(), set.contacts.begin() + set.firstPair,
+                               [](const Contact& c) { return c.kind == ContactKind::FaceCollider; });
   // The projection followed its collider contacts along the way it moved them, so their
   // positions now are outside and reached legally; the fail-safe traces them from there. A
   // straight path from the substep's start may cut through a body the projection slid them

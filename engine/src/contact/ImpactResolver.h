@@ -127,7 +127,10 @@ class ImpactResolver {
   Vec3Array m_projected;                     // x as the projection left it
   std::vector<char> m_tracked;               // per vertex: in a collider contact of the set
   std::vector<Real> m_colliderSeparation;    // per vertex: how far it is kept from a body (m)
-  Vec3Array m_beforeFaces;                   // x before the face sweeps
+  Vec3Array m_beforeFaces;                   // per face corner: x before the face sweeps
+  std::vector<char> m_faceCorner;            // per vertex: in m_faceCorners
+  std::vector<Index> m_faceCorners;          // corners of the faces the sweeps visited
+  bool m_faceContacts = false;               // the set has face contacts
   std::vector<signed char> m_held;           // per vertex: −1 unknown, 0 free, 1 held
   std::vector<Index> m_zoneParent;           // union–find over vertices
   std::vector<char> m_inZone;
