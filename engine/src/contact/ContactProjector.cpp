@@ -97,6 +97,9 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
                                            const ProjectionSettings& settings,
                                            std::vector<FaceSupport>& supports) {
   WEFT_PROFILE_ZONE("project");
+  // The sweep order and the vertex → edge table are the space's; a space put together by hand
+  // (tests) gets them here.
+  if (!space.edgeSlotsListed()) space.listEdgeSlots();
   ProjectionReport report;
   const std::size_t count = set.size();
   m_pushed.assign(count, 0);
@@ -166,11 +169,10 @@ void ContactProjector::startTracking(ContactSpace& space) {
   // The edges a full sweep would not skip. Tracked once at most half of them are: where most
   // edges move every sweep, listing them costs more than the scan it saves.
   const Index edgeCount = Index(space.edges.size());
-  const bool ordered = space.edgeOrder.size() == space.edges.size();
   m_pendingEdges.reset(edgeCount, false);
   Index pending = 0;
   for (Index slot = 0; slot < edgeCount; ++slot) {
-    const Index e = ordered ? space.edgeOrder[slot] : slot;
+    const Index e = space.edgeOrder[slot];
     const std::uint64_t moves = std::uint64_t(m_moves[space.edges[e][0]]) + m_moves[space.edges[e][1]];
     if (moves != m_edgeSeenMoves[e]) {
       m_pendingEdges.insert(slot);
@@ -178,11 +180,6 @@ void ContactProjector::startTracking(ContactSpace& space) {
     }
   }
   if (2 * pending > edgeCount) return;
-  // The table is the space's; a space put together by hand (tests) gets it here.
-  if (space.edgeSlotBegin.size() != std::size_t(space.vertexCount()) + 1 ||
-      space.edgeSlots.size() != 2 * space.edges.size()) {
-    space.listEdgeSlots();
-  }
   m_edgeSlotBegin = space.edgeSlotBegin;
   m_edgeSlots = space.edgeSlots;
   // Every tether once more in the first tracked sweep, as in an untracked one.
@@ -291,7 +288,6 @@ Index ContactProjector::sweepEdgesAs(ContactSpace& space, Real tolerance, bool b
       ++i;
     }
   }
-  const bool ordered = space.edgeOrder.size() == space.edges.size();
   const bool anchored = space.anchorDistance.size() == space.x.size() && m_followTheLeader;
   // The next edge in sweep order; once tracking, those settled since their last visit left out.
   const auto following = [&](Index slot) {
@@ -309,7 +305,7 @@ Index ContactProjector::sweepEdgesAs(ContactSpace& space, Real tolerance, bool b
     first = kInvalidIndex;
   }
   for (Index slot = first; slot != kInvalidIndex; slot = following(slot)) {
-    const Index e = ordered ? space.edgeOrder[slot] : slot;
+    const Index e = space.edgeOrder[slot];
     const Index a = space.edges[e][0], b = space.edges[e][1];
     // Left within its limit at its last visit, and neither end moved since: still within it.
     const std::uint64_t moves = std::uint64_t(m_moves[a]) + m_moves[b];

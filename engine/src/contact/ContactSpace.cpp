@@ -86,7 +86,10 @@ void ContactSpace::build(std::span<Cloth* const> cloths) {
 }
 
 void ContactSpace::listEdgeSlots() {
-  const bool ordered = edgeOrder.size() == edges.size();
+  if (edgeOrder.size() != edges.size()) {
+    edgeOrder.resize(edges.size());
+    for (Index e = 0; e < Index(edges.size()); ++e) edgeOrder[e] = e;
+  }
   edgeSlotBegin.assign(x.size() + 1, 0);
   for (const std::array<Index, 2>& edge : edges) {
     ++edgeSlotBegin[edge[0] + 1];
@@ -96,7 +99,7 @@ void ContactSpace::listEdgeSlots() {
   edgeSlots.resize(2 * edges.size());
   std::vector<Index> fill(edgeSlotBegin.begin(), edgeSlotBegin.end() - 1);
   for (Index slot = 0; slot < Index(edges.size()); ++slot) {
-    for (Index vertex : edges[ordered ? edgeOrder[slot] : slot]) edgeSlots[fill[vertex]++] = slot;
+    for (Index vertex : edges[edgeOrder[slot]]) edgeSlots[fill[vertex]++] = slot;
   }
 }
 

@@ -91,12 +91,19 @@ class ContactSpace {
   /// The edges in the order the projector sweeps them: by the anchor distance of their nearer
   /// end, then by index (nearest the pins first).
   std::vector<Index> edgeOrder;
-  /// Per vertex, the positions in edgeOrder of its edges (the positions are the edges' indices
-  /// when edgeOrder is empty): those of vertex i are edgeSlots[edgeSlotBegin[i],
-  /// edgeSlotBegin[i + 1]), the edges a move of the vertex may take over their limit.
+  /// Per vertex, the positions in edgeOrder of its edges: those of vertex i are
+  /// edgeSlots[edgeSlotBegin[i], edgeSlotBegin[i + 1]), the edges a move of the vertex may take
+  /// over their limit.
   std::vector<Index> edgeSlotBegin, edgeSlots;
-  /// Builds edgeSlotBegin and edgeSlots from edges and edgeOrder (build() does; allocates).
+  /// Builds edgeSlotBegin and edgeSlots from edges and edgeOrder, giving edges that edgeOrder
+  /// does not list (a space put together by hand) their index order. build() calls it; the
+  /// projector does for a space whose tables do not match its edges. Allocates.
   void listEdgeSlots();
+  /// True when edgeOrder, edgeSlotBegin and edgeSlots are those of the current edges and vertices.
+  bool edgeSlotsListed() const {
+    return edgeOrder.size() == edges.size() && edgeSlots.size() == 2 * edges.size() &&
+           edgeSlotBegin.size() == x.size() + 1;
+  }
 
   /// Marks whether a cloth's faces are kept out of colliders (ClothSettings::faceContacts).
   bool faceContacts(Index vertex) const {
