@@ -144,7 +144,7 @@ INSTANTIATE_TEST_SUITE_P(
              name(std::get<1>(info.param));
     });
 
-enum class Press { Box, MeshBox, Sphere };
+enum class Press { Box, MeshBox, Sphere, Capsule };
 
 // A box of half extents `half` as a closed triangle mesh (12 triangles, wound outwards).
 TriangleMeshShape boxMesh(const Vec3& half, const RigidMotion& motion) {
@@ -164,10 +164,10 @@ class Squeeze : public ::testing::TestWithParam<std::tuple<Press, Real>> {};
 TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   const auto [shape, gap] = GetParam();
   World world;
-  // A 0.6 m sheet lying on a box whose top is at y = 0; a box (analytic, or a 12-triangle mesh)
-  // or a sphere comes down onto it at 0.5 m/s and stops `gap` above the box. Under the box's
-  // edges the sheet steps from the gap up to its thickness, so the box's edges, as face-contact
-  // cores, lie over the faces there.
+  // A 0.6 m sheet lying on a box whose top is at y = 0; a box (analytic, or a 12-triangle mesh),
+  // a sphere or a capsule lying across comes down onto it at 0.5 m/s and stops `gap` above the
+  // box. Under the box's edges the sheet steps from the gap up to its thickness, so the box's
+  // edges, as face-contact cores, lie over the faces there.
   const Vec3 half(0.5, 0.1, 0.5);
   RigidMotion below;
   below.pose.position = Vec3(0, -half.y(), 0);
@@ -183,6 +183,12 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
     case Press::Sphere:
       top = world.addCollider(Sphere::create(pressHalf.y(), press).value()).value();
       break;
+    case Press::Capsule: {
+      RigidMotion lying = press;  // its axis along x, a rod as long as the box is wide
+      lying.pose.rotation = Quat(Eigen::AngleAxis<Real>(std::acos(Real(0)), Vec3::UnitZ()));
+      top = world.addCollider(Capsule::create(pressHalf.y(), pressHalf.x(), lying).value()).value();
+      break;
+    }
   }
   // Cotton, with its strain limit: the press must neither tear the sheet out from between the
   // bodies nor stretch it past the limit.
@@ -265,13 +271,16 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
 
 INSTANTIATE_TEST_SUITE_P(
     Presses, Squeeze,
-    ::testing::Combine(::testing::Values(Press::Box, Press::MeshBox, Press::Sphere),
+    ::testing::Combine(::testing::Values(Press::Box, Press::MeshBox, Press::Sphere,
+                                         Press::Capsule),
                        ::testing::Values(Real(0.0005), Real(0.001), Real(0.0015), Real(0.002),
                                          Real(0.0025))),
     [](const auto& info) {
       const Press shape = std::get<0>(info.param);
-      const char* press =
-          shape == Press::Box ? "Box" : shape == Press::MeshBox ? "MeshBox" : "Sphere";
+      const char* press = shape == Press::Box       ? "Box"
+                          : shape == Press::MeshBox ? "MeshBox"
+                          : shape == Press::Sphere  ? "Sphere"
+                                                    : "Capsule";
       return std::string(press) + "To" +
              std::to_string(int(std::lround(10000 * std::get<1>(info.param)))) + "TenthsOfAMillimetre";
     });
