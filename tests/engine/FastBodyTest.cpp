@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <string>
 #include <tuple>
@@ -146,6 +147,16 @@ INSTANTIATE_TEST_SUITE_P(
 
 enum class Press { Box, MeshBox, Sphere, Capsule };
 
+const char* name(Press press) {
+  switch (press) {
+    case Press::Box: return "Box";
+    case Press::MeshBox: return "MeshBox";
+    case Press::Sphere: return "Sphere";
+    case Press::Capsule: return "Capsule";
+  }
+  return "";
+}
+
 // A box of half extents `half` as a closed triangle mesh (12 triangles, wound outwards).
 TriangleMeshShape boxMesh(const Vec3& half, const RigidMotion& motion) {
   std::vector<Vec3> corners;
@@ -256,6 +267,7 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
       std::to_string(unresolved) + " frames with unresolved contacts, " +
       std::to_string(overLimit) + " past the strain limit (largest " +
       std::to_string(worstStrain) + ")";
+  std::printf("[squeeze] %s to %.1f mm: %s\n", name(shape), 1000 * gap, figures.c_str());
   if (shape == Press::MeshBox && gap < 0.001) {
     test::knownEngineFailure(
         held, "a sheet squeezed to 0.5 mm under a box modelled as a mesh rests, resolved",
@@ -276,12 +288,7 @@ INSTANTIATE_TEST_SUITE_P(
                        ::testing::Values(Real(0.0005), Real(0.001), Real(0.0015), Real(0.002),
                                          Real(0.0025))),
     [](const auto& info) {
-      const Press shape = std::get<0>(info.param);
-      const char* press = shape == Press::Box       ? "Box"
-                          : shape == Press::MeshBox ? "MeshBox"
-                          : shape == Press::Sphere  ? "Sphere"
-                                                    : "Capsule";
-      return std::string(press) + "To" +
+      return std::string(name(std::get<0>(info.param))) + "To" +
              std::to_string(int(std::lround(10000 * std::get<1>(info.param)))) + "TenthsOfAMillimetre";
     });
 
