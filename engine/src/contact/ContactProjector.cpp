@@ -165,7 +165,7 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
   return report;
 }
 
-void ContactProjector::startTracking(ContactSpace& space) {
+void ContactProjector::startTracking(const ContactSpace& space) {
   // The edges a full sweep would not skip. Tracked once at most half of them are: where most
   // edges move every sweep, listing them costs more than the scan it saves.
   const Index edgeCount = Index(space.edges.size());

@@ -119,7 +119,7 @@ class ContactProjector {
   // Takes the edge at sweep position `slot`, between vertices a and b, off the pending edges.
   void settle(Index slot, Index a, Index b);
   // From the next sweep on, the edge sweeps visit only the pending edges, if few enough are.
-  void startTracking(ContactSpace& space);
+  void startTracking(const ContactSpace& space);
   // One sweep over the contacts; returns how many were violated beyond tolerance.
   Index sweepContacts(ContactSpace& space, const ContactSet& set,
                       std::span<const ColliderFrame> colliders, Real h, Real tolerance,
