@@ -230,10 +230,11 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
       ASSERT_TRUE(world.setColliderMotion(top, press).ok());
     }
     const StepStatus status = health(world.step(kFrame));
-    // Flagged only with the press within twice the thickness of the floor; always under the box,
-    // whose flat bottom holds the vertices it caught, while the cloth is stepped (asleep, it has
-    // no contacts to report). A vertex under the sphere may be pushed aside to where the room is
-    // wider, so there only the frame that closes the gap is sure.
+    // Flagged only with the press within twice the thickness of the floor; always under a box
+    // (analytic or mesh), whose flat bottom holds the vertices it caught, and under the capsule,
+    // whose length holds a row of them, while the cloth is stepped (asleep, it has no contacts to
+    // report). A vertex under the sphere may be pushed aside to where the room is wider, so there
+    // only the frame that closes the gap is sure.
     const Real pressBottom =
         motion(*world.collider(top).value()).pose.position.y() - pressHalf.y();
     const bool squeezed = hasFlag(status, StepStatus::Squeezed);
