@@ -114,6 +114,7 @@ struct RunFigures {
   Real maxStrain = 0;
   Index contacts = 0;  ///< vertices in contact at the last frame
   Real faceContacts = 0;  ///< face contacts per frame (StepStats::faceContacts), mean
+  Real sweeps = 0;  ///< projection sweeps per frame (StepStats::strainLimitIterations), mean
 
   void keepFaster(const RunFigures& other) {
     cpuMs = std::min(cpuMs, other.cpuMs);
@@ -137,6 +138,7 @@ RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, 
     figures.wallMs += wallMs() - wall;
     figures.maxStrain = std::max(figures.maxStrain, world.stats().maxStrain);
     figures.faceContacts += Real(world.stats().faceContacts) / frames;
+    figures.sweeps += Real(world.stats().strainLimitIterations) / frames;
   }
   figures.cpuMs /= frames;
   figures.wallMs /= frames;
@@ -164,13 +166,13 @@ void compare(const std::string& scene, const std::string& analyticName, const Sh
     }
   }
   std::printf("  %-9s best: %-22s cpu %8.3f wall %8.3f ms/frame (strain %.4f, contacts %u, "
-              "face contacts %.0f/frame)\n",
+              "face contacts %.0f/frame, sweeps %.1f/frame)\n",
               scene.c_str(), analyticName.c_str(), a.cpuMs, a.wallMs, a.maxStrain, a.contacts,
-              a.faceContacts);
+              a.faceContacts, a.sweeps);
   std::printf("  %-9s best: %-22s cpu %8.3f wall %8.3f ms/frame (strain %.4f, contacts %u, "
-              "face contacts %.0f/frame)\n",
+              "face contacts %.0f/frame, sweeps %.1f/frame)\n",
               scene.c_str(), meshName.c_str(), m.cpuMs, m.wallMs, m.maxStrain, m.contacts,
-              m.faceContacts);
+              m.faceContacts, m.sweeps);
   std::printf("  %-9s ratio mesh / analytic (best cpu): %.2f\n\n", scene.c_str(), m.cpuMs / a.cpuMs);
 }
 

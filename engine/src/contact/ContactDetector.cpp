@@ -76,6 +76,68 @@ void ContactDetector::selectNear(const ContactSpace& space,
   }
 }
 
+template <class Fn>
+void ContactDetector::forEachVertex(Index count, Fn&& fn) {
+  if (m_tasks) {
+    m_tasks->parallelFor(count, kGrainVertexQueries,
+                         [&](Index begin, Index end, int) { fn(begin, end); });
+  } else {
+    fn(0, count);
+  }
+}
+
+ContactDetector::DeepestContact ContactDetector::deepestContact(
+    const ContactSpace& space, std::span<const ColliderFrame> colliders, Index i) const {
+  if (space.inverseMass[i] == 0) return {};
+  const Real thickness = thicknessOf(space, i);
+  const Vec3& predicted = m_predicted[i];
+  // The deepest contact wins when a vertex touches several colliders: one direction per
+  // vertex in the solve; the projector then keeps it off the others.
+  Real deepest = (1 + kPressedShell) * thickness;
+  Vec3 normal = Vec3::Zero();
+  Index touched = kInvalidIndex;
+  for (Index k : m_near) {
+    const ColliderFrame& collider = colliders[k];
+    Vec3 direction = Vec3::Zero();
+    Real depth = 0;
+    // Where the predicted motion relative to the body first meets it gives the face to stop
+    // on: the end pose alone would push a vertex a fast body overran out through its far side.
+    const std::optional<PathContact> hit =
+        firstContactAlong(collider, space.startX[i], predicted, thickness);
+    if (!hit) {
+      // Only an end deeper than the deepest so far counts.
+      const std::optional<ShapeContact> below =
+          queryPointBelow(collider.shape, predicted, deepest);
+      if (!below) continue;
+      direction = below->normal;
+      depth = below->distance;
+    } else {
+      const ShapeContact contact = queryPoint(collider.shape, predicted);
+      direction = contact.normal;
+      depth = contact.distance;
+      // A path that stays outside after it comes near is a graze: the end's own distance
+      // holds. Extrapolating the hit's tangent plane would overshoot on a curved body. A
+      // two-sided shell (an open mesh) has no inside to show the middle in: there the path
+      // from the hit on is tested for a crossing instead.
+      const bool graze =
+          contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
+          queryPoint(collider.shape, 0.5 * (hit->point + predicted)).distance > 0 &&
+          !shellCrossing(collider.shape, hit->point, predicted);
+      if (!graze) {
+        direction = hit->impactNormal;
+        depth = hit->distance + hit->normal.dot(predicted - hit->point);
+      }
+    }
+    if (depth < deepest) {
+      deepest = depth;
+      normal = direction;
+      touched = k;
+    }
+  }
+  if (touched == kInvalidIndex) return {};
+  return {normal, deepest, touched};
+}
+
 void ContactDetector::constrain(const ContactSpace& space,
                                 std::span<const ColliderFrame> colliders, Real h,
                                 std::span<const FaceSupport> supports,
@@ -89,56 +151,18 @@ void ContactDetector::constrain(const ContactSpace& space,
   selectNear(space, colliders, m_predicted, 0, counts);
   m_constrained.assign(n, 0);
   if (!m_near.empty()) {
+    // Each vertex's deepest contact, in parallel (a query against a mesh costs microseconds);
+    // the constraints are then listed in vertex order.
+    m_deepest.resize(n);
+    forEachVertex(n, [&](Index begin, Index end) {
+      for (Index i = begin; i < end; ++i) m_deepest[i] = deepestContact(space, colliders, i);
+    });
     for (Index i = 0; i < n; ++i) {
-      if (space.inverseMass[i] == 0) continue;
-      const Real thickness = thicknessOf(space, i);
-      const Vec3& predicted = m_predicted[i];
-      // The deepest contact wins when a vertex touches several colliders: one direction per
-      // vertex in the solve; the projector then keeps it off the others.
-      Real deepest = (1 + kPressedShell) * thickness;
-      Vec3 normal = Vec3::Zero();
-      Index touched = kInvalidIndex;
-      for (Index k : m_near) {
-        const ColliderFrame& collider = colliders[k];
-        Vec3 direction = Vec3::Zero();
-        Real depth = 0;
-        // Where the predicted motion relative to the body first meets it gives the face to stop
-        // on: the end pose alone would push a vertex a fast body overran out through its far side.
-        const std::optional<PathContact> hit =
-            firstContactAlong(collider, space.startX[i], predicted, thickness);
-        if (!hit) {
-          // Only an end deeper than the deepest so far counts.
-          const std::optional<ShapeContact> below =
-              queryPointBelow(collider.shape, predicted, deepest);
-          if (!below) continue;
-          direction = below->normal;
-          depth = below->distance;
-        } else {
-          const ShapeContact contact = queryPoint(collider.shape, predicted);
-          direction = contact.normal;
-          depth = contact.distance;
-          // A path that stays outside after it comes near is a graze: the end's own distance
-          // holds. Extrapolating the hit's tangent plane would overshoot on a curved body. A
-          // two-sided shell (an open mesh) has no inside to show the middle in: there the path
-          // from the hit on is tested for a crossing instead.
-          const bool graze =
-              contact.distance > 0 && contact.normal.dot(hit->normal) > 0 &&
-              queryPoint(collider.shape, 0.5 * (hit->point + predicted)).distance > 0 &&
-              !shellCrossing(collider.shape, hit->point, predicted);
-          if (!graze) {
-            direction = hit->impactNormal;
-            depth = hit->distance + hit->normal.dot(predicted - hit->point);
-          }
-        }
-        if (depth < deepest) {
-          deepest = depth;
-          normal = direction;
-          touched = k;
-        }
-      }
-      if (touched == kInvalidIndex) continue;
+      const DeepestContact& deepest = m_deepest[i];
+      if (deepest.collider == kInvalidIndex) continue;
       // n·Δv that ends the step at the thickness: d(x + h(v + Δv)) ≈ d(x + h v) + h n·Δv.
-      out.push_back({i, normal, (thickness - deepest) / h, touched});
+      out.push_back({i, deepest.normal, (thicknessOf(space, i) - deepest.depth) / h,
+                     deepest.collider});
       m_constrained[i] = 1;
     }
   }
@@ -187,43 +211,65 @@ void ContactDetector::detect(const ContactSpace& space, std::span<const Collider
   if (pairs) detectPairs(space, set);
 }
 
+ContactDetector::VertexQuery ContactDetector::queryVertex(const ContactSpace& space,
+                                                         const ColliderFrame& collider,
+                                                         Real margin, Index i) {
+  const Real thickness = thicknessOf(space, i);
+  VertexQuery query;
+  // An end within the margin is a contact; one beyond it, only where the path hit the body.
+  query.end = queryPointBelow(collider.shape, space.x[i], thickness + margin);
+  if (!query.end) {
+    query.hit = firstContactAlong(collider, space.startX[i], space.x[i], thickness);
+    if (!query.hit) return query;
+    query.end = queryPoint(collider.shape, space.x[i]);
+  }
+  const Vec3 start = collider.carry(space.startX[i]);
+  query.resting =
+      queryPointBelow(collider.shape, start, (1 + kPressedShell) * thickness).has_value();
+  return query;
+}
+
 void ContactDetector::detectColliderVertices(const ContactSpace& space,
                                              std::span<const ColliderFrame> colliders,
                                              std::span<const Real> solveImpulses,
                                              std::span<const Index> constrainedCollider,
                                              Real margin, ContactSet& set,
                                              DetectionCounts& counts) {
-  m_vertexContacts.resize(space.vertexCount() + 1);
-  for (Index i = 0; i < space.vertexCount(); ++i) {
+  const Index n = space.vertexCount();
+  const std::size_t near = m_near.size();
+  // The queries, in parallel (a query against a mesh costs microseconds); the contacts are then
+  // listed in vertex order.
+  m_vertexQueries.resize(n * near);
+  forEachVertex(n, [&](Index begin, Index end) {
+    for (Index i = begin; i < end; ++i) {
+      if (space.inverseMass[i] == 0) continue;
+      for (std::size_t j = 0; j < near; ++j) {
+        m_vertexQueries[i * near + j] = queryVertex(space, colliders[m_near[j]], margin, i);
+      }
+    }
+  });
+  m_vertexContacts.resize(n + 1);
+  for (Index i = 0; i < n; ++i) {
     m_vertexContacts[i] = set.contacts.size();
     if (space.inverseMass[i] == 0) continue;
     const Real thickness = thicknessOf(space, i);
     const Real friction = space.owners[space.owner[i]].friction;
     const std::size_t first = set.contacts.size();
     m_surfaceNormals.clear();
-    for (Index k : m_near) {
-      const ColliderFrame& collider = colliders[k];
-      const Vec3 start = collider.carry(space.startX[i]);
-      // An end within the margin is a contact; one beyond it, only where the path hit the body.
-      std::optional<ShapeContact> end =
-          queryPointBelow(collider.shape, space.x[i], thickness + margin);
-      std::optional<PathContact> hit;
-      if (!end) {
-        hit = firstContactAlong(collider, space.startX[i], space.x[i], thickness);
-        if (!hit) continue;
-        end = queryPoint(collider.shape, space.x[i]);
-      }
+    for (std::size_t j = 0; j < near; ++j) {
+      const Index k = m_near[j];
+      const VertexQuery& query = m_vertexQueries[i * near + j];
+      if (!query.end) continue;
       Contact contact;
       contact.kind = ContactKind::VertexCollider;
       contact.vertices[0] = i;
-      contact.normal = hit ? hit->normal : end->normal;
-      m_surfaceNormals.push_back(end->normal);
+      contact.normal = query.hit ? query.hit->normal : query.end->normal;
+      m_surfaceNormals.push_back(query.end->normal);
       contact.separation = thickness;
-      contact.gap = end->distance;
-      contact.friction = std::sqrt(std::max<Real>(0, collider.friction) * friction);
+      contact.gap = query.end->distance;
+      contact.friction = std::sqrt(std::max<Real>(0, colliders[k].friction) * friction);
       contact.collider = k;
-      contact.resting =
-          queryPointBelow(collider.shape, start, (1 + kPressedShell) * thickness).has_value();
+      contact.resting = query.resting;
       if (!solveImpulses.empty() && constrainedCollider[i] == k) {
         contact.solveImpulse = std::max<Real>(0, solveImpulses[i]);
       }

@@ -34,6 +34,7 @@
 #include <weft/threading/TaskSystem.h>
 
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -123,6 +124,28 @@ class ContactDetector {
                    const Vec3& corePoint, const Vec3& normal, Real thickness,
                    ContactSet& set) const;
   void detectPairs(const ContactSpace& space, ContactSet& set);
+  // What a vertex's solved end and path show of one collider (detectColliderVertices()).
+  struct VertexQuery {
+    std::optional<ShapeContact> end;  // the end's contact; none: no contact
+    std::optional<PathContact> hit;   // where the path met the body, for an end beyond the margin
+    bool resting = false;             // the start pressed on the body
+  };
+  // Vertex i's contact with `collider`: its end within thickness + `margin` or its path hitting.
+  static VertexQuery queryVertex(const ContactSpace& space, const ColliderFrame& collider,
+                                 Real margin, Index i);
+  // A vertex's deepest contact with a collider for the solve (constrain()).
+  struct DeepestContact {
+    Vec3 normal = Vec3::Zero();
+    Real depth = 0;                  // m, signed distance at the predicted end
+    Index collider = kInvalidIndex;  // none: no contact
+  };
+  // Vertex i's deepest contact over the near colliders at its predicted end, m_predicted[i].
+  DeepestContact deepestContact(const ContactSpace& space,
+                                std::span<const ColliderFrame> colliders, Index i) const;
+  // fn(begin, end) over [0, count) in fixed blocks, on the tasks when there are any: for per-vertex
+  // collider queries, which write only their own vertex's slots.
+  template <class Fn>
+  void forEachVertex(Index count, Fn&& fn);
   // The colliders whose box comes near the cloth's motion, into m_near; counts both kinds.
   void selectNear(const ContactSpace& space, std::span<const ColliderFrame> colliders,
                   const Vec3Array& end, Real margin, DetectionCounts& counts);
@@ -140,6 +163,8 @@ class ContactDetector {
   std::vector<FaceCore> m_bodyCores;
   Vec3Array m_predicted;            // x₀ + h v₀, constrain()
   std::vector<char> m_constrained;  // per vertex: constrained by constrain() already
+  std::vector<DeepestContact> m_deepest;  // per vertex, constrain()
+  std::vector<VertexQuery> m_vertexQueries;  // per vertex × near collider, detect()
 };
 
 }  // namespace weft

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 
 namespace weft {
 namespace {
@@ -85,24 +86,33 @@ Index ImpactResolver::keepOutOfColliders(ContactSpace& space, const ContactSet& 
   }
   if (m_near.empty()) return 0;  // and so no face contact either
   WEFT_PROFILE_ZONE("collider impacts");
-  Index corrected = 0;
-  for (Index i = 0; i < space.vertexCount(); ++i) {
-    if (space.inverseMass[i] == 0) continue;
-    const Real thickness = m_colliderSeparation[i];
-    bool moved = false;
-    for (Index k : m_near) {
-      const ColliderFrame& collider = colliders[k];
-      const Vec3 outside = keepVertexOutside(i, collider, space, space.x[i], thickness);
-      if (outside == space.x[i]) continue;
-      space.x[i] = outside;
-      // Inelastic: no relative velocity into the surface.
-      const ShapeContact on = queryPoint(collider.shape, outside);
-      const Real approach = (space.v[i] - on.velocity).dot(on.normal);
-      if (approach < 0) space.v[i] -= approach * on.normal;
-      moved = true;
+  // Each vertex on its own (it reads and writes only its own slots), in parallel: a query against
+  // a mesh costs microseconds.
+  const auto keepBlockOutside = [&](Index begin, Index end) {
+    Index moved = 0;
+    for (Index i = begin; i < end; ++i) {
+      if (space.inverseMass[i] == 0) continue;
+      const Real thickness = m_colliderSeparation[i];
+      bool kept = false;
+      for (Index k : m_near) {
+        const ColliderFrame& collider = colliders[k];
+        const Vec3 outside = keepVertexOutside(i, collider, space, space.x[i], thickness);
+        if (outside == space.x[i]) continue;
+        space.x[i] = outside;
+        // Inelastic: no relative velocity into the surface.
+        const ShapeContact on = queryPoint(collider.shape, outside);
+        const Real approach = (space.v[i] - on.velocity).dot(on.normal);
+        if (approach < 0) space.v[i] -= approach * on.normal;
+        kept = true;
+      }
+      moved += kept;
     }
-    corrected += moved;
-  }
+    return moved;
+  };
+  const Index corrected =
+      m_tasks ? m_tasks->parallelReduce(space.vertexCount(), kGrainVertexQueries, Index(0),
+                                        keepBlockOutside, std::plus<Index>())
+              : keepBlockOutside(0, space.vertexCount());
   // Then the faces on bodies thinner than the triangles, which have the last word: a vertex
   // pushed out of one capsule of a ring may tilt its face into the next.
   pushFacesOut(set, space.inverseMass, space.x, space.v, 0, false);
