@@ -32,6 +32,9 @@ constexpr Real kOpposedNormals = -0.5;
 // Feature pairs per parallel block: a closest-point test costs ~50–100 ns, so 128 pairs are
 // 5–15 µs of work, above a fork/join.
 constexpr TaskSystem::Index kGrainFeaturePairs = 128;
+// Faces per parallel block of face-contact detection: a face away from the body costs ~40 ns,
+// one over a mesh a few µs (its tree's box query), so 256 faces are 10 µs to a millisecond.
+constexpr TaskSystem::Index kGrainFaces = 256;
 
 // Thickness of a vertex's cloth.
 Real thicknessOf(const ContactSpace& space, Index vertex) {
@@ -303,65 +306,96 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
   m_vertexContacts[space.vertexCount()] = set.contacts.size();
 }
 
+void ContactDetector::findFaceCores(const ContactSpace& space, const ColliderFrame& collider,
+                                    const Aabb& body, Real margin, Index face,
+                                    FaceBlock& block) const {
+  const std::array<Index, 3>& corner = space.triangles[face];
+  if (!space.faceContacts(corner[0])) return;
+  if (space.inverseMass[corner[0]] == 0 && space.inverseMass[corner[1]] == 0 &&
+      space.inverseMass[corner[2]] == 0) {
+    return;
+  }
+  // The face's path relative to the body, against the body at its end pose: its start carried
+  // with the body, and its end. A face may cross a thin body within one substep, and a fast body
+  // may cross a face that barely moves (its box at the end pose alone is then far from the
+  // face). With the margin: the projection may move a face that far towards the body; with the
+  // bulge: a turning body's relative paths are arcs.
+  Aabb box = Aabb::empty();
+  Real bulge = 0;
+  for (Index i : corner) addRelativePath(collider, space.startX[i], space.x[i], box, bulge);
+  box.inflate(margin + bulge);
+  if (!box.overlaps(body)) return;
+  const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&collider.shape);
+  const Real allowance = thicknessOf(space, corner[0]);
+  block.cores.clear();
+  appendCores(collider.shape, allowance, block.cores);
+  if (block.cores.empty() && !mesh) return;  // a plane: vertices only
+  // The face's path in the body's frame (start and end), against each core's box.
+  const Pose& endPose = collider.end.pose;
+  const Pose& startPose = collider.start.pose;
+  Aabb path = Aabb::empty();
+  std::array<Vec3, 3> startLocal;
+  for (int j = 0; j < 3; ++j) {
+    startLocal[j] = startPose.toLocal(space.startX[corner[j]]);
+    path.expand(startLocal[j]);
+    path.expand(endPose.toLocal(space.x[corner[j]]));
+  }
+  path.inflate(margin);
+  if (mesh) {
+    Aabb near = path;
+    near.inflate(0.5 * allowance);
+    // The face's extent: its longest edge at the start or the end.
+    Real span = 0;
+    for (int j = 0; j < 3; ++j) {
+      const Index from = corner[j], to = corner[(j + 1) % 3];
+      span = std::max({span, (space.startX[to] - space.startX[from]).norm(),
+                       (space.x[to] - space.x[from]).norm()});
+    }
+    appendMeshCores(*mesh, near, allowance, span, block.cores, block.triangles, block.edges);
+  }
+  for (const FaceCore& core : block.cores) {
+    if (!core.box.overlaps(path)) continue;
+    // Which side of the core the face started on (zero: it started on the core).
+    const SegmentTriangleClosestPoints before = closestPointsOnSegmentAndTriangle(
+        core.start, core.end, startLocal[0], startLocal[1], startLocal[2]);
+    block.found.push_back({face, core, before});
+  }
+}
+
 void ContactDetector::detectColliderFaces(const ContactSpace& space,
                                           std::span<const ColliderFrame> colliders,
                                           std::span<const Real> solveImpulses,
                                           std::span<const Index> constrainedCollider,
                                           Real margin, ContactSet& set) {
   WEFT_PROFILE_ZONE("face contacts");
+  const Index faces = Index(space.triangles.size());
+  const Index blocks = TaskSystem::blockCount(faces, kGrainFaces);
+  if (m_faceBlocks.size() < blocks) m_faceBlocks.resize(blocks);
   for (Index k : m_near) {
     const ColliderFrame& collider = colliders[k];
-    const TriangleMeshShape* mesh = std::get_if<TriangleMeshShape>(&collider.shape);
     const Aabb body = bounds(collider.shape);
+    // The cores each face may touch, in parallel over fixed blocks of faces (a face over a mesh
+    // queries the mesh's tree); then, in face order, the contacts.
+    const auto findBlock = [&](Index begin, Index end) {
+      FaceBlock& block = m_faceBlocks[begin / kGrainFaces];
+      block.found.clear();
+      for (Index t = begin; t < end; ++t) findFaceCores(space, collider, body, margin, t, block);
+    };
+    if (m_tasks) {
+      m_tasks->parallelFor(faces, kGrainFaces, [&](Index begin, Index end, int) {
+        findBlock(begin, end);
+      });
+    } else {
+      for (Index b = 0; b < blocks; ++b) {
+        findBlock(b * kGrainFaces, std::min(faces, (b + 1) * kGrainFaces));
+      }
+    }
     const Pose& endPose = collider.end.pose;
-    const Pose& startPose = collider.start.pose;
-    for (Index t = 0; t < Index(space.triangles.size()); ++t) {
-      const std::array<Index, 3>& corner = space.triangles[t];
-      if (!space.faceContacts(corner[0])) continue;
-      if (space.inverseMass[corner[0]] == 0 && space.inverseMass[corner[1]] == 0 &&
-          space.inverseMass[corner[2]] == 0) {
-        continue;
-      }
-      // The face's path relative to the body, against the body at its end pose: its start
-      // carried with the body, and its end. A face may cross a thin body within one substep, and
-      // a fast body may cross a face that barely moves (its box at the end pose alone is then
-      // far from the face). With the margin: the projection may move a face that far towards
-      // the body; with the bulge: a turning body's relative paths are arcs.
-      Aabb box = Aabb::empty();
-      Real bulge = 0;
-      for (Index i : corner) addRelativePath(collider, space.startX[i], space.x[i], box, bulge);
-      box.inflate(margin + bulge);
-      if (!box.overlaps(body)) continue;
-      const Real allowance = thicknessOf(space, corner[0]);
-      m_bodyCores.clear();
-      appendCores(collider.shape, allowance, m_bodyCores);
-      if (m_bodyCores.empty() && !mesh) continue;  // a plane: vertices only
-      // The face's path in the body's frame (start and end), against each core's box.
-      Aabb path = Aabb::empty();
-      std::array<Vec3, 3> startLocal;
-      for (int j = 0; j < 3; ++j) {
-        startLocal[j] = startPose.toLocal(space.startX[corner[j]]);
-        path.expand(startLocal[j]);
-        path.expand(endPose.toLocal(space.x[corner[j]]));
-      }
-      path.inflate(margin);
-      if (mesh) {
-        Aabb near = path;
-        near.inflate(0.5 * allowance);
-        // The face's extent: its longest edge at the start or the end.
-        Real span = 0;
-        for (int j = 0; j < 3; ++j) {
-          const Index from = corner[j], to = corner[(j + 1) % 3];
-          span = std::max({span, (space.startX[to] - space.startX[from]).norm(),
-                           (space.x[to] - space.x[from]).norm()});
-        }
-        appendMeshCores(*mesh, near, allowance, span, m_bodyCores, m_meshTriangles, m_meshEdges);
-      }
-      for (const FaceCore& core : m_bodyCores) {
-        if (!core.box.overlaps(path)) continue;
-        // Which side of the core the face started on (zero: it started on the core).
-        const SegmentTriangleClosestPoints before = closestPointsOnSegmentAndTriangle(
-            core.start, core.end, startLocal[0], startLocal[1], startLocal[2]);
+    for (Index b = 0; b < blocks; ++b) {
+      for (const FaceCandidate& found : m_faceBlocks[b].found) {
+        const std::array<Index, 3>& corner = space.triangles[found.face];
+        const Real allowance = thicknessOf(space, corner[0]);
+        const SegmentTriangleClosestPoints& before = found.before;
         Contact contact;
         contact.kind = ContactKind::FaceCollider;
         contact.vertices = {corner[0], corner[1], corner[2], kInvalidIndex};
@@ -369,13 +403,13 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
         if (before.distance > 0) {
           contact.normal = (before.pointOnTriangle - before.pointOnSegment) / before.distance;
         }
-        contact.separation = core.reach;
-        contact.gap = before.distance - core.reach;
+        contact.separation = found.core.reach;
+        contact.gap = before.distance - found.core.reach;
         contact.friction = std::sqrt(std::max<Real>(0, collider.friction) *
                                      space.owners[space.owner[corner[0]]].friction);
         contact.collider = k;
         contact.core = Index(set.cores.size());
-        contact.resting = before.distance <= core.reach + kRestingFaceShell * allowance;
+        contact.resting = before.distance <= found.core.reach + kRestingFaceShell * allowance;
         // The solve's support of a face resting on the body: its corners' constraints, averaged
         // as the centroid where friction acts takes them.
         if (!solveImpulses.empty()) {
@@ -385,7 +419,7 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
             }
           }
         }
-        set.cores.push_back(core);
+        set.cores.push_back(found.core);
         if (before.distance > 0) {
           squeezeFace(colliders, contact, endPose.toWorld(before.pointOnSegment),
                       endPose.rotation * contact.normal, allowance, set);

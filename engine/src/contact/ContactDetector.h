@@ -20,8 +20,9 @@
 //    and normal are those of the nearer end, oriented to the side the pair started on, which x₀
 //    (free of crossings) tells. Features closer than the thickness in the rest shape of one cloth
 //    are neighbours in the material and never a contact.
-// The exact tests run in parallel over fixed blocks; contacts are put back in pair order, so the
-// set is the same on any thread count.
+// The collider queries (per vertex, per face) and the exact pair tests run in parallel over fixed
+// blocks; contacts are listed in vertex, face and pair order, so the set is the same on any thread
+// count.
 #pragma once
 
 #include "contact/ColliderFrame.h"
@@ -30,6 +31,7 @@
 #include "contact/FeaturePairs.h"
 #include "contact/OrderedPairFilter.h"
 
+#include <weft/collision/Proximity.h>
 #include <weft/threading/PerWorker.h>
 #include <weft/threading/TaskSystem.h>
 
@@ -133,6 +135,22 @@ class ContactDetector {
   // Vertex i's contact with `collider`: its end within thickness + `margin` or its path hitting.
   static VertexQuery queryVertex(const ContactSpace& space, const ColliderFrame& collider,
                                  Real margin, Index i);
+  // A core of a collider that a face may touch (detectColliderFaces()).
+  struct FaceCandidate {
+    Index face;
+    FaceCore core;                       // body frame
+    SegmentTriangleClosestPoints before;  // core to the face at its start: the side it came from
+  };
+  // One fixed block of faces: what it found and its scratch.
+  struct FaceBlock {
+    std::vector<FaceCandidate> found;
+    std::vector<FaceCore> cores;
+    std::vector<Index> triangles, edges;
+  };
+  // Appends to block.found the cores of `collider` that face `face` may touch over the substep.
+  // `body`: the collider's world box.
+  void findFaceCores(const ContactSpace& space, const ColliderFrame& collider, const Aabb& body,
+                     Real margin, Index face, FaceBlock& block) const;
   // A vertex's deepest contact with a collider for the solve (constrain()).
   struct DeepestContact {
     Vec3 normal = Vec3::Zero();
@@ -158,9 +176,7 @@ class ContactDetector {
   std::vector<std::size_t> m_vertexContacts;  // per vertex + 1: its first collider contact
   std::vector<Vec3> m_surfaceNormals;  // the current vertex's contacts: the bodies' normals at it
   OrderedPairFilter<Contact> m_pairFilter;
-  std::vector<Index> m_meshTriangles;
-  std::vector<Index> m_meshEdges;
-  std::vector<FaceCore> m_bodyCores;
+  std::vector<FaceBlock> m_faceBlocks;  // per fixed block of faces, detectColliderFaces()
   Vec3Array m_predicted;            // x₀ + h v₀, constrain()
   std::vector<char> m_constrained;  // per vertex: constrained by constrain() already
   std::vector<DeepestContact> m_deepest;  // per vertex, constrain()
