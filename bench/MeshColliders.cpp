@@ -3,6 +3,7 @@
 //
 //   build/bench/weft-mesh-colliders [--frames 120] [--repeats 3] [--threads 1] [--self true]
 //                                   [--queries true] [--scenes sphere,cylinder,large]
+//                                   [--zones false]
 //
 // Pairs of scenes, each a cloth dropped from rest onto a body at the origin and draping:
 //   sphere    41 × 41 vertices (1,681), 1.2 m square, 0.5 m up, on a 0.3 m sphere: the analytic
@@ -14,12 +15,15 @@
 // The configurations alternate (A, M, A, M, …) so that a machine shared with other jobs slows
 // both alike; a run's cost is the calling thread's CPU time per frame of World::step (and the
 // wall time), the smallest of the repeats is kept, and every repeat's M / A ratio is printed.
+// --zones prints, for each configuration's last repeat, the profiler zones of the calling thread
+// in ms per frame (nested zones are inside their parents: "step" is the whole frame).
 #include "BenchClock.h"
 
 #include <weft/collision/Box.h>
 #include <weft/collision/Sphere.h>
 #include <weft/collision/TriangleMeshShape.h>
 #include <weft/engine/World.h>
+#include <weft/threading/Profiler.h>
 
 #include <CLI/CLI.hpp>
 
@@ -27,6 +31,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <map>
 #include <memory>
 #include <random>
 #include <string>
@@ -115,6 +120,7 @@ struct RunFigures {
   Index contacts = 0;  ///< vertices in contact at the last frame
   Real faceContacts = 0;  ///< face contacts per frame (StepStats::faceContacts), mean
   Real sweeps = 0;  ///< projection sweeps per frame (StepStats::strainLimitIterations), mean
+  std::string zones;  ///< "name ms, …" per frame of the calling thread's zones, when asked
 
   void keepFaster(const RunFigures& other) {
     cpuMs = std::min(cpuMs, other.cpuMs);
@@ -122,7 +128,29 @@ struct RunFigures {
   }
 };
 
-RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, bool self) {
+// "name ms, …": the calling thread's zones since the profiler was cleared, in ms per frame,
+// largest first.
+std::string zoneSummary(int frames) {
+  std::map<std::string, double> totals;
+  const std::vector<ZoneRecord> zones = Profiler::instance().zones();
+  const std::uint32_t caller = zones.empty() ? 0 : zones.front().threadIndex;
+  for (const ZoneRecord& zone : zones) {
+    if (zone.threadIndex == caller) totals[zone.name] += 1e-6 * double(zone.endNs - zone.beginNs);
+  }
+  std::vector<std::pair<double, std::string>> sorted;
+  for (const auto& [name, ms] : totals) sorted.emplace_back(ms / frames, name);
+  std::sort(sorted.rbegin(), sorted.rend());
+  std::string text;
+  char figure[32];
+  for (const auto& [ms, name] : sorted) {
+    std::snprintf(figure, sizeof figure, " %.2f", ms);
+    text += (text.empty() ? "" : ", ") + name + figure;
+  }
+  return text;
+}
+
+RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, bool self,
+               bool zones) {
   WorldSettings settings;
   settings.threadCount = threads;
   World world(settings);
@@ -131,6 +159,11 @@ RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, 
   clothSettings.selfCollision = self;
   (void)world.createCloth(square(clothVertices, 1.2, 0.5), clothSettings).value();
   RunFigures figures;
+  if (zones) {
+    Profiler::instance().clear();
+    Profiler::instance().registerThisThread("simulation");
+    Profiler::instance().setEnabled(true);
+  }
   for (int frame = 0; frame < frames; ++frame) {
     const double cpu = threadCpuMs(), wall = wallMs();
     world.step(1.0 / 60.0);
@@ -140,6 +173,10 @@ RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, 
     figures.faceContacts += Real(world.stats().faceContacts) / frames;
     figures.sweeps += Real(world.stats().strainLimitIterations) / frames;
   }
+  if (zones) {
+    Profiler::instance().setEnabled(false);
+    figures.zones = zoneSummary(frames);
+  }
   figures.cpuMs /= frames;
   figures.wallMs /= frames;
   figures.contacts = world.stats().contacts;
@@ -148,15 +185,21 @@ RunFigures run(const Shape& body, Index clothVertices, int frames, int threads, 
 
 void compare(const std::string& scene, const std::string& analyticName, const Shape& analytic,
              const std::string& meshName, const Shape& mesh, Index clothVertices, int frames,
-             int repeats, int threads, bool self) {
+             int repeats, int threads, bool self, bool zones) {
   RunFigures a, m;
   for (int repeat = 0; repeat < repeats; ++repeat) {
-    const RunFigures ra = run(analytic, clothVertices, frames, threads, self);
-    const RunFigures rm = run(mesh, clothVertices, frames, threads, self);
+    const RunFigures ra = run(analytic, clothVertices, frames, threads, self, zones);
+    const RunFigures rm = run(mesh, clothVertices, frames, threads, self, zones);
     std::printf("  %-9s repeat %d: %-22s cpu %8.3f ms/frame   %-22s cpu %8.3f ms/frame   "
                 "ratio %.2f\n",
                 scene.c_str(), repeat, analyticName.c_str(), ra.cpuMs, meshName.c_str(), rm.cpuMs,
                 rm.cpuMs / ra.cpuMs);
+    if (zones) {
+      std::printf("  %-9s zones, ms/frame: %s: %s\n", scene.c_str(), analyticName.c_str(),
+                  ra.zones.c_str());
+      std::printf("  %-9s zones, ms/frame: %s: %s\n", scene.c_str(), meshName.c_str(),
+                  rm.zones.c_str());
+    }
     if (repeat == 0) {
       a = ra;
       m = rm;
@@ -223,6 +266,8 @@ int main(int argc, char** argv) {
   app.add_option("--self", self, "Self-collision on (true/false)");
   bool queries = true;
   app.add_option("--queries", queries, "Also time queryPoint alone (true/false)");
+  bool zones = false;
+  app.add_option("--zones", zones, "Print the profiler zones per frame of each run (true/false)");
   CLI11_PARSE(app, argc, argv);
 
   std::printf("weft-mesh-colliders: %d frames, %d repeat(s), %d thread(s), self-collision %s\n\n",
@@ -236,7 +281,7 @@ int main(int argc, char** argv) {
     const Shape mesh = TriangleMeshShape::create(ball.vertices, ball.indices).value();
     compare(scene, "Sphere", analytic,
             "UV sphere (" + std::to_string(ball.indices.size() / 3) + " tris)", mesh,
-            clothVertices, frames, repeats, threads, self);
+            clothVertices, frames, repeats, threads, self, zones);
     if (timeQueries) queryCost(analytic, mesh, kRadius);
   };
   if (scenes.find("sphere") != std::string::npos) compareSpheres("sphere", 56, 55, 41, queries);
@@ -248,7 +293,7 @@ int main(int argc, char** argv) {
     const Shape mesh = TriangleMeshShape::create(post.vertices, post.indices).value();
     compare("cylinder", "Box", analytic,
             "cylinder (" + std::to_string(post.indices.size() / 3) + " tris)", mesh, 35, frames,
-            repeats, threads, self);
+            repeats, threads, self, zones);
     if (queries) queryCost(analytic, mesh, kRadius);
   }
   return 0;
