@@ -1,13 +1,17 @@
-// Cloth against kinematic colliders: resting on a sphere and a floor, and friction from a
-// spinning sphere (fast projectiles: FastBodyTest.cpp). In every frame of every scene no vertex
-// is inside a collider and no two triangles of the cloth intersect (exact test).
+// Cloth against kinematic colliders: resting on a sphere and a floor, friction from a spinning
+// sphere, and a drape over a triangle mesh that is the same on any thread count (fast
+// projectiles: FastBodyTest.cpp). In every frame of the first three scenes no vertex is inside a
+// collider and no two triangles of the cloth intersect (exact test).
 #include "ContactTestSupport.h"
+#include "collision/CollisionTestSupport.h"
 
+#include <weft/collision/TriangleMeshShape.h>
 #include <weft/engine/World.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdint>
 
 namespace weft {
 namespace {
@@ -107,6 +111,41 @@ TEST(Collider, FrictionOfASpinningSphereDragsTheCloth) {
   // The sphere's surface moves with ω × r, whose angular momentum about +y is positive.
   EXPECT_GT(spins[1], 1e-3) << "friction should drag the cloth round";
   EXPECT_LT(std::abs(spins[0]), 0.1 * std::abs(spins[1])) << "without friction it barely turns";
+}
+
+TEST(Collider, ADrapeOverAMeshIsBitwiseTheSameOnOneTwoAndEightThreads) {
+  // 1,681 vertices and 3,200 faces over a 48-sided cylinder: the collider queries of many fixed
+  // blocks of vertices and faces run on different threads, and the rim's edges make face
+  // contacts. The state must not depend on which thread ran which block.
+  struct Drape {
+    std::uint64_t hash = 0;
+    Index vertexContacts = 0;  // at the last frame
+    Index faceContacts = 0;    // over all frames
+  };
+  const auto drape = [](int threads) {
+    WorldSettings worldSettings;
+    worldSettings.threadCount = threads;
+    World world(worldSettings);
+    const test::MeshArrays post = test::makeCylinder(0.3, 0.3, 48);
+    (void)world.addCollider(TriangleMeshShape::create(post.positions, post.indices).value()).value();
+    (void)world.createCloth(square(41, 1.2, 0.45), ClothSettings{}).value();
+    Drape result;
+    for (int frame = 0; frame < 40; ++frame) {
+      EXPECT_EQ(world.step(kFrame), StepStatus::Ok) << threads << " threads, frame " << frame;
+      result.faceContacts += world.stats().faceContacts;
+    }
+    result.vertexContacts = world.stats().contacts;
+    result.hash = world.stateHash();
+    return result;
+  };
+  const Drape one = drape(1);
+  EXPECT_GT(one.vertexContacts, 100u) << "the cloth no longer lies on the cylinder's top";
+  EXPECT_GT(one.faceContacts, 0u) << "no face met the rim: the faces' mesh path is not tested";
+  for (int threads : {2, 8}) {
+    const Drape other = drape(threads);
+    EXPECT_EQ(other.hash, one.hash) << threads << " threads";
+    EXPECT_EQ(other.faceContacts, one.faceContacts) << threads << " threads";
+  }
 }
 
 TEST(Collider, HandlesGoStale) {
