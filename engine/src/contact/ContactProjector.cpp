@@ -22,6 +22,9 @@ constexpr Real kUnresolvedShortfall = 0.1;
 // the sweeps that satisfy the strain limit and the separations cannot undo what it holds (a
 // towel resting on a rod by its faces would creep along it).
 constexpr int kFrictionSweeps = std::numeric_limits<int>::max();
+// Sweeps in which a change of friction alone keeps the projection going (the header says why it
+// stops counting).
+constexpr int kFrictionCountedSweeps = 16;
 // Sweeps in which the edges follow the leader (only the end farther from the pins moves): the first
 // brings a hanging chain within its limit from the pins down in one pass; the later ones share
 // each correction by mass, which lets a load from the far side (a body pushing the cloth's middle)
@@ -137,6 +140,7 @@ ProjectionReport ContactProjector::project(ContactSpace& space, const ContactSet
     }
     const bool backward = iteration % 2 == 1;
     m_frictionOn = iteration < kFrictionSweeps;
+    m_frictionCounted = iteration < kFrictionCountedSweeps;
     m_followTheLeader = iteration < kFollowTheLeaderSweeps;
     const Index over = sweepEdges(space, settings.strainTolerance, backward);
     const Index violated =
@@ -446,7 +450,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   x += correction - applied;
   moved(i, correction != applied);
   m_friction[index] = correction;
-  return std::max(depth, (correction - applied).norm());
+  return m_frictionCounted ? std::max(depth, (correction - applied).norm()) : depth;
 }
 
 Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const Contact& contact,
@@ -510,7 +514,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
     moved(corner[j], b[j] != 0 && change != Vec3::Zero());
   }
   m_friction[index] = correction;
-  return std::max(depth, change.norm());
+  return m_frictionCounted ? std::max(depth, change.norm()) : depth;
 }
 
 Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact,
@@ -559,7 +563,7 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
   const Real slipped = (correction - m_friction[index]).norm();
   move(correction - m_friction[index]);
   m_friction[index] = correction;
-  return std::max({Real(0), shortfall, slipped});
+  return std::max({Real(0), shortfall, m_frictionCounted ? slipped : Real(0)});
 }
 
 Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,

@@ -29,7 +29,8 @@
 // none of its vertices is skipped alike until one of them moves.
 // Every position change Δx is made as the velocity change Δx / h too, so v stays the substep's
 // average velocity. Sweeps alternate direction; the iteration stops when no edge is over its
-// limit by more than the tolerance and no contact is violated by more than its tolerance.
+// limit by more than the tolerance and no contact is violated by more than its tolerance, a
+// change of its friction counting as a violation only in the first 16 sweeps (below).
 //
 // Friction. A contact's friction may remove at most μ D of the tangential displacement of its two
 // sides over the substep, D being its normal displacement: how far the projection has moved its
@@ -41,7 +42,11 @@
 // substep takes it on its velocity instead (its end is where its path slid on from the hit, not
 // x₀ + h v). Friction acts in every sweep, its accumulated correction bounded by that budget, so
 // the later sweeps' strain and separation corrections cannot undo what it holds, and a cloth
-// pulled over a body at its limit still slides once its budget is spent.
+// pulled over a body at its limit still slides once its budget is spent. Where other contacts
+// keep moving a pair apart by a few µm a sweep (a folded hem in self-contact), its budget moves
+// with them and its friction follows for hundreds of sweeps without settling; after 16 sweeps
+// only separations and strain decide when the iteration stops, friction acting in every sweep
+// still.
 //
 // After the iteration: collider contacts and pairs keep no relative normal velocity into each
 // other (inelastic), and the face points left resting on a core are returned as supports, which
@@ -139,6 +144,7 @@ class ContactProjector {
   Vec3Array m_lastOutside;        // vertex contacts: where the vertex last was outside
   std::vector<std::pair<Real, Real>> m_pairMass;  // pairs: pairInverseMass, fixed in a projection
   bool m_frictionOn = true;       // friction acts in this sweep
+  bool m_frictionCounted = true;  // a change of friction alone counts as a violation this sweep
   bool m_followTheLeader = true;  // edges move only their end farther from the pins
   std::vector<char> m_visited;    // visited in an earlier sweep (a vertex contact's path tested)
   // Per contact: its vertices' m_moves after a visit that moved none of them (sweepContacts
