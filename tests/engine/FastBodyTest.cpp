@@ -211,6 +211,7 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   test::StepHealth health;
   bool closed = false, flagged = false;
   int unresolved = 0, overLimit = 0;  // frames with unresolved contacts, past the strain limit
+  int firstUnresolved = -1;           // the first frame with unresolved contacts
   Real worstStrain = 0;
   std::string broken;  // the first frame with a vertex inside a body, and which
   auto check = [&](bool holds, int frame, const std::string& what) {
@@ -247,6 +248,9 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
     }
     flagged = flagged || squeezed;
     unresolved += hasFlag(status, StepStatus::ContactsUnresolved);
+    if (firstUnresolved < 0 && hasFlag(status, StepStatus::ContactsUnresolved)) {
+      firstUnresolved = frame;
+    }
     overLimit += hasFlag(status, StepStatus::StrainLimitExceeded);
     worstStrain = std::max(worstStrain, world.stats().maxStrain);
     EXPECT_EQ(world.stats().squeezedVertices > 0, squeezed) << "frame " << frame;
@@ -265,14 +269,16 @@ TEST_P(Squeeze, ClothBetweenTwoBodiesClosingBelowItsThicknessEndsBetweenThem) {
   const bool held = broken.empty() && unresolved == 0 && overLimit == 0;
   const std::string figures =
       (broken.empty() ? std::string("outside both bodies") : broken) + "; " +
-      std::to_string(unresolved) + " frames with unresolved contacts, " +
+      std::to_string(unresolved) + " frames with unresolved contacts" +
+      (firstUnresolved >= 0 ? " (the first: frame " + std::to_string(firstUnresolved) + ")" : "") +
+      ", " +
       std::to_string(overLimit) + " past the strain limit (largest " +
       std::to_string(worstStrain) + ")";
   std::printf("[squeeze] %s to %.1f mm: %s\n", name(shape), 1000 * gap, figures.c_str());
   if (shape == Press::MeshBox && gap < 0.001) {
     test::knownEngineFailure(
         held, "a sheet squeezed to 0.5 mm under a box modelled as a mesh rests, resolved",
-        figures + ". From frame 57 on, faces round the mesh's bottom corners keep their full "
+        figures + ". There, faces round the mesh's bottom corners keep their full "
                   "reach (0.75 mm) from the corner under a 0.5 mm gap: they came to it from below "
                   "and outwards, at 110 degrees to the floor's normal, short of the 120 at which "
                   "a face is taken as squeezed, and end the projection's 256 sweeps 0.3-0.6 mm "
