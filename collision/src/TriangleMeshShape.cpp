@@ -217,6 +217,8 @@ void TriangleMeshShape::setEdgeShapes(Geometry& geometry,
     const Real convexTurn = geometry.closed ? std::max<Real>(turn, 0) : std::abs(turn);
     edge.ridgeSlope = std::isinf(convexTurn) ? infinity : std::tan(convexTurn / 2);
     edge.curvature = std::isinf(convexTurn) ? infinity : edge.ridgeSlope / width;
+    geometry.maxRidgeSlope = std::max(geometry.maxRidgeSlope, edge.ridgeSlope);
+    geometry.maxCurvature = std::max(geometry.maxCurvature, edge.curvature);
   }
   // A vertex whose faces fold back on it, or whose normals cancel, peaks without bound.
   geometry.vertexSlopes.assign(geometry.vertices.size(), 0);
@@ -227,6 +229,7 @@ void TriangleMeshShape::setEdgeShapes(Geometry& geometry,
       const Real slope = cosine > 1e-3 ? std::sqrt(std::max<Real>(0, 1 - cosine * cosine)) / cosine
                                        : infinity;
       geometry.vertexSlopes[v] = std::max(geometry.vertexSlopes[v], slope);
+      geometry.maxVertexSlope = std::max(geometry.maxVertexSlope, slope);
     }
   }
 }

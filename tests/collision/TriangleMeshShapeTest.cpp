@@ -176,6 +176,31 @@ TEST(TriangleMeshShape, TheQueryBelowADistanceFindsEveryPointInsideOrNearerAndNo
   EXPECT_GT(beyond, 100);
 }
 
+TEST(TriangleMeshShape, TheMostBulgeIsTheLargestOfItsEdgesAndVertices) {
+  // maxBulge(span) is what lets a face skip a mesh's tree: it must be at least every edge's bulge
+  // and every vertex's rise at that span (bit for bit: the face tests compare against it), and
+  // no more than the largest of them.
+  const test::MeshArrays rod = test::makeCylinder(0.3, 0.3, 48);
+  const CubeMesh cube = makeCube(Vec3(0.5, 0.5, 0.5));
+  const CubeMesh top = makeTableTop(0.5, 0);
+  const TriangleMeshShape shapes[] = {
+      TriangleMeshShape::create(rod.positions, rod.indices).value(),
+      TriangleMeshShape::create(cube.vertices, cube.indices).value(),
+      TriangleMeshShape::create(top.vertices, top.indices).value()};
+  for (const TriangleMeshShape& shape : shapes) {
+    for (Real span : {1e-4, 0.01, 0.05, 0.3, 2.0}) {
+      Real largest = 0;
+      for (const MeshEdge& edge : shape.edges()) largest = std::max(largest, edge.bulge(span));
+      for (Index v = 0; v < Index(shape.localVertices().size()); ++v) {
+        largest = std::max(largest, shape.vertexSlope(v) * span / 2);
+      }
+      EXPECT_EQ(shape.maxBulge(span), largest) << shape.triangleCount() << " triangles, span " << span;
+    }
+  }
+  // The open quad's border is a fin: it bulges without bound at any span.
+  EXPECT_TRUE(std::isinf(shapes[2].maxBulge(1e-6)));
+}
+
 TEST(TriangleMeshShape, EdgesKnowHowFarTheSurfaceBulgesIntoAFaceOverThem) {
   // A cube: its twelve edges turn a right angle (slope tan 45° = 1), the diagonals of its faces
   // not at all; a corner's faces stand 54.7° off its normal (slope √2).

@@ -276,9 +276,11 @@ bool faceClearOfCore(const FaceCore& core, const Vec3& cameFrom, const Vec3& a, 
 void appendMeshCores(const TriangleMeshShape& mesh, const Aabb& near, Real allowance, Real span,
                      std::vector<FaceCore>& cores, std::vector<Index>& triangleScratch,
                      std::vector<Index>& edgeScratch) {
-  mesh.localBvh().queryBox(near, triangleScratch);
-  // The edges and vertices that bulge into the face, each once (most of a smooth mesh's none).
+  // The edges and vertices that bulge into the face, each once (most of a smooth mesh's none,
+  // and where nothing in the mesh bulges that far, no search of its tree).
   const Real clearance = kMeshEdgeClearance * allowance;
+  if (!(mesh.maxBulge(span) > clearance)) return;
+  mesh.localBvh().queryBox(near, triangleScratch);
   edgeScratch.clear();
   for (Index meshTriangle : triangleScratch) {
     for (Index edge : mesh.triangleEdges(meshTriangle)) {

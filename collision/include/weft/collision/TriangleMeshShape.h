@@ -94,6 +94,14 @@ class TriangleMeshShape {
   /// The steepest of vertex v's faces against its normal, as a slope (tan of the angle; infinite
   /// from a right angle): how sharply the surface peaks at v (see the design note).
   Real vertexSlope(Index v) const { return m_geometry->vertexSlopes[v]; }
+  /// m, the most any edge or vertex of the mesh bulges into a flat face of extent `span` (m): at
+  /// least every MeshEdge::bulge(span) and (span / 2)·vertexSlope(v). A face that nothing bulges
+  /// into by more than a clearance needs no edge of the mesh tested (a smooth mesh's faces).
+  Real maxBulge(Real span) const {
+    const Geometry& g = *m_geometry;
+    return std::max({g.maxRidgeSlope * span / 2, g.maxCurvature * span * span / 4,
+                     g.maxVertexSlope * span / 2});
+  }
   /// Indices into edges() of triangle t's edges: corner k's edge runs from corner k to k + 1.
   std::span<const Index, 3> triangleEdges(Index t) const {
     return std::span<const Index, 3>(m_geometry->triangleEdges.data() + 3 * std::size_t(t), 3);
@@ -146,6 +154,9 @@ class TriangleMeshShape {
     std::vector<MeshEdge> edges;      // each edge once, sorted
     std::vector<Index> triangleEdges; // per triangle corner k: its edge (k, k+1) in edges
     std::vector<Real> vertexSlopes;   // per vertex, vertexSlope()
+    Real maxRidgeSlope = 0;           // the largest of the edges' ridgeSlope, curvature and the
+    Real maxCurvature = 0;            // vertices' slopes: maxBulge()
+    Real maxVertexSlope = 0;
     bool closed = false;              // every edge has exactly two triangles
   };
   std::shared_ptr<const Geometry> m_geometry;
