@@ -80,13 +80,12 @@ void ContactDetector::selectNear(const ContactSpace& space,
 }
 
 template <class Fn>
-void ContactDetector::forEachVertex(Index count, Fn&& fn) {
+void ContactDetector::forEachBlock(Index count, Index grain, Fn&& fn) {
   if (m_tasks) {
-    m_tasks->parallelFor(count, kGrainVertexQueries,
-                         [&](Index begin, Index end, int) { fn(begin, end); });
-  } else {
-    fn(0, count);
+    m_tasks->parallelFor(count, grain, [&](Index begin, Index end, int) { fn(begin, end); });
+    return;
   }
+  for (Index begin = 0; begin < count; begin += grain) fn(begin, std::min(begin + grain, count));
 }
 
 ContactDetector::DeepestContact ContactDetector::deepestContact(
@@ -157,7 +156,7 @@ void ContactDetector::constrain(const ContactSpace& space,
     // Each vertex's deepest contact, in parallel (a query against a mesh costs microseconds);
     // the constraints are then listed in vertex order.
     m_deepest.resize(n);
-    forEachVertex(n, [&](Index begin, Index end) {
+    forEachBlock(n, kGrainVertexQueries, [&](Index begin, Index end) {
       for (Index i = begin; i < end; ++i) m_deepest[i] = deepestContact(space, colliders, i);
     });
     for (Index i = 0; i < n; ++i) {
@@ -243,7 +242,7 @@ void ContactDetector::detectColliderVertices(const ContactSpace& space,
   // The queries, in parallel (a query against a mesh costs microseconds); the contacts are then
   // listed in vertex order.
   m_vertexQueries.resize(n * near);
-  forEachVertex(n, [&](Index begin, Index end) {
+  forEachBlock(n, kGrainVertexQueries, [&](Index begin, Index end) {
     for (Index i = begin; i < end; ++i) {
       if (space.inverseMass[i] == 0) continue;
       for (std::size_t j = 0; j < near; ++j) {
@@ -376,20 +375,11 @@ void ContactDetector::detectColliderFaces(const ContactSpace& space,
     const Aabb body = bounds(collider.shape);
     // The cores each face may touch, in parallel over fixed blocks of faces (a face over a mesh
     // queries the mesh's tree); then, in face order, the contacts.
-    const auto findBlock = [&](Index begin, Index end) {
+    forEachBlock(faces, kGrainFaces, [&](Index begin, Index end) {
       FaceBlock& block = m_faceBlocks[begin / kGrainFaces];
       block.found.clear();
       for (Index t = begin; t < end; ++t) findFaceCores(space, collider, body, margin, t, block);
-    };
-    if (m_tasks) {
-      m_tasks->parallelFor(faces, kGrainFaces, [&](Index begin, Index end, int) {
-        findBlock(begin, end);
-      });
-    } else {
-      for (Index b = 0; b < blocks; ++b) {
-        findBlock(b * kGrainFaces, std::min(faces, (b + 1) * kGrainFaces));
-      }
-    }
+    });
     const Pose& endPose = collider.end.pose;
     for (Index b = 0; b < blocks; ++b) {
       for (const FaceCandidate& found : m_faceBlocks[b].found) {

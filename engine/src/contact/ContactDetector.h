@@ -160,10 +160,11 @@ class ContactDetector {
   // Vertex i's deepest contact over the near colliders at its predicted end, m_predicted[i].
   DeepestContact deepestContact(const ContactSpace& space,
                                 std::span<const ColliderFrame> colliders, Index i) const;
-  // fn(begin, end) over [0, count) in fixed blocks, on the tasks when there are any: for per-vertex
-  // collider queries, which write only their own vertex's slots.
+  // fn(begin, end) for each fixed block [k·grain, min((k+1)·grain, count)), on the tasks when
+  // there are any, in order on the caller otherwise: for the per-vertex and per-face collider
+  // queries, each block writing only its own slots.
   template <class Fn>
-  void forEachVertex(Index count, Fn&& fn);
+  void forEachBlock(Index count, Index grain, Fn&& fn);
   // The colliders whose box comes near the cloth's motion, into m_near; counts both kinds.
   void selectNear(const ContactSpace& space, std::span<const ColliderFrame> colliders,
                   const Vec3Array& end, Real margin, DetectionCounts& counts);

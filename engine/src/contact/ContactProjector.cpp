@@ -450,7 +450,7 @@ Real ContactProjector::projectVertex(ContactSpace& space, std::size_t index,
   x += correction - applied;
   moved(i, correction != applied);
   m_friction[index] = correction;
-  return m_frictionCounted ? std::max(depth, (correction - applied).norm()) : depth;
+  return std::max(depth, frictionViolation((correction - applied).norm()));
 }
 
 Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const Contact& contact,
@@ -514,7 +514,7 @@ Real ContactProjector::projectFace(ContactSpace& space, std::size_t index, const
     moved(corner[j], b[j] != 0 && change != Vec3::Zero());
   }
   m_friction[index] = correction;
-  return m_frictionCounted ? std::max(depth, change.norm()) : depth;
+  return std::max(depth, frictionViolation(change.norm()));
 }
 
 Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const Contact& contact,
@@ -563,7 +563,7 @@ Real ContactProjector::projectPair(ContactSpace& space, std::size_t index, const
   const Real slipped = (correction - m_friction[index]).norm();
   move(correction - m_friction[index]);
   m_friction[index] = correction;
-  return std::max({Real(0), shortfall, m_frictionCounted ? slipped : Real(0)});
+  return std::max({Real(0), shortfall, frictionViolation(slipped)});
 }
 
 Index ContactProjector::finish(ContactSpace& space, const ContactSet& set,

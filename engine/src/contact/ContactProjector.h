@@ -30,7 +30,7 @@
 // Every position change Δx is made as the velocity change Δx / h too, so v stays the substep's
 // average velocity. Sweeps alternate direction; the iteration stops when no edge is over its
 // limit by more than the tolerance and no contact is violated by more than its tolerance, a
-// change of its friction counting as a violation only in the first 16 sweeps (below).
+// change of its friction counting as a violation only in the first sweeps (below).
 //
 // Friction. A contact's friction may remove at most μ D of the tangential displacement of its two
 // sides over the substep, D being its normal displacement: how far the projection has moved its
@@ -44,9 +44,9 @@
 // the later sweeps' strain and separation corrections cannot undo what it holds, and a cloth
 // pulled over a body at its limit still slides once its budget is spent. Where other contacts
 // keep moving a pair apart by a few µm a sweep (a folded hem in self-contact), its budget moves
-// with them and its friction follows for hundreds of sweeps without settling; after 16 sweeps
-// only separations and strain decide when the iteration stops, friction acting in every sweep
-// still.
+// with them and its friction follows for hundreds of sweeps without settling; after
+// kFrictionCountedSweeps (16) only separations and strain decide when the iteration stops,
+// friction acting in every sweep still.
 //
 // After the iteration: collider contacts and pairs keep no relative normal velocity into each
 // other (inelastic), and the face points left resting on a core are returned as supports, which
@@ -145,6 +145,8 @@ class ContactProjector {
   std::vector<std::pair<Real, Real>> m_pairMass;  // pairs: pairInverseMass, fixed in a projection
   bool m_frictionOn = true;       // friction acts in this sweep
   bool m_frictionCounted = true;  // a change of friction alone counts as a violation this sweep
+  // How much a friction change of `change` (m) counts towards a contact's violation this sweep.
+  Real frictionViolation(Real change) const { return m_frictionCounted ? change : 0; }
   bool m_followTheLeader = true;  // edges move only their end farther from the pins
   std::vector<char> m_visited;    // visited in an earlier sweep (a vertex contact's path tested)
   // Per contact: its vertices' m_moves after a visit that moved none of them (sweepContacts
