@@ -34,13 +34,6 @@ constexpr int kFollowTheLeaderSweeps = 1;
 // every edge (VisitSet.h), and tries again at every power of two after while too many are left:
 // most projections end sooner, and a try costs about one scan.
 constexpr int kTrackingFromSweep = 4;
-// Successive over-relaxation of an edge's correction where an end rests on a body: projected on
-// the surfaces, the corrections of a patch stretched over a body and sliding on it spread edge by
-// edge, one Gauss–Seidel sweep at a time; over-relaxed they spread several edges a sweep. The
-// step never carries the edge past the far side of its limit, so it still ends within it. Higher
-// values cut more sweeps but move the cloth farther than plain Gauss–Seidel from the solve's
-// positions, which shows as slower settling of crumpled piles and creep of cloth resting on a rod.
-constexpr Real kHeldOverRelaxation = 1.6;
 // m: face points closer than this outside their reach still count as touching (a point the
 // projection just put at the reach is at −1e-17).
 constexpr Real kTouching = 1e-9;
@@ -90,17 +83,14 @@ Real heldWeight(Real weightA, Real weightB, const Vec3& normalA, const Vec3& nor
 // The fraction of a held correction that brings the edge vector `delta`, changed by `change`, to
 // length `longest` (the first root), or where it is shortest when it cannot get that short: the
 // correction is linearised, and across a normal nearly along the edge it would carry an end far
-// past the edge's shortest point. Over-relaxed by kHeldOverRelaxation up to the second root,
-// where the edge would reach its limit again.
+// past the edge's shortest point.
 Real heldStepFraction(const Vec3& delta, const Vec3& change, Real longest) {
   const Real a = change.squaredNorm(), b = delta.dot(change);
   if (!(a > 0) || !(b < 0)) return 0;
   const Real c = delta.squaredNorm() - longest * longest;
   const Real discriminant = b * b - a * c;
-  if (discriminant < 0) return std::min<Real>(1, -b / a);
-  const Real root = std::sqrt(discriminant);
-  const Real first = std::min<Real>(1, (-b - root) / a);
-  return std::min(kHeldOverRelaxation * first, (-b + root) / a);
+  const Real fraction = discriminant >= 0 ? (-b - std::sqrt(discriminant)) / a : -b / a;
+  return std::min<Real>(1, fraction);
 }
 
 }  // namespace
@@ -347,8 +337,7 @@ Index ContactProjector::sweepEdgesAs(ContactSpace& space, Real tolerance, bool b
     if (!normalA.isZero() || !normalB.isZero()) {
       // An end resting on a collider slides on it: its share of the correction loses the part
       // along the surface's normal, which the contact would undo (GS would then zig-zag along a
-      // curved body), and the step is cut where it brings the edge to its limit, over-relaxed
-      // (kHeldOverRelaxation).
+      // curved body), and the step is cut where it brings the edge to its limit.
       const Vec3 direction = delta / length;
       const Real held = heldWeight(weightA, weightB, normalA, normalB, direction);
       if (held == 0) continue;

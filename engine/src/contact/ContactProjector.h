@@ -11,9 +11,7 @@
 //    ContactSpace::anchorDistance), which brings a long or heavily loaded hanging chain within its
 //    limit in one pass, where shared corrections would diffuse edge by edge;
 //    an end resting on a collider is moved only across the surface's normal, so the edges slide
-//    it on the body instead of pulling it in for the contact to push out again, and such an
-//    edge's correction is over-relaxed (SOR), which spreads a patch's slide over the body several
-//    edges a sweep instead of one;
+//    it on the body instead of pulling it in for the contact to push out again;
 //  - vertex–collider: the signed distance to the body (posed at the substep end) ≥ thickness,
 //    re-evaluated at the vertex's current position, the vertex followed from where it was last
 //    outside (a vertex an edge pulls across a thin body goes back to its own side);
