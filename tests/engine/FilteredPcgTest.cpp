@@ -586,7 +586,7 @@ TEST_P(FilteredPcgTest, VelocityErrorSolvesAreBitwiseIdenticalOnOneAndTwoThreads
   VertexFilter filter;
   filter.resize(kVertices);
   filter.setFixed(20, Vec3(0, -0.2, 0));
-  filter.setConstrained(3000, Vec3(0, 1, 0), Vec3(0, 0.1, 0));
+  filter.setConstrained(kVertices - 100, Vec3(0, 1, 0), Vec3(0, 0.1, 0));
   const std::vector<Real> masses(kVertices, 0.5);
   TaskSystem serial(TaskSystemSettings{1});
   TaskSystem twoThreads(TaskSystemSettings{2});

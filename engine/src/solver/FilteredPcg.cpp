@@ -214,8 +214,10 @@ void packTriangleRange(Index begin, Index end, const BlockSparseMatrix& A,
 }
 
 /// Σ_j A_ij x_j over one triangle's entries of sweep position k: general blocks, then isotropic.
-inline Vec3 triangleProduct(Index k, const SweepTriangle& entries, const PackedTriangle& packed,
-                            const Vec3Array& x) {
+/// Always inlined: it is the inner loop of every sweep, and a call per row costs a tenth of it.
+[[gnu::always_inline]] inline Vec3 triangleProduct(Index k, const SweepTriangle& entries,
+                                                   const PackedTriangle& packed,
+                                                   const Vec3Array& x) {
   Vec3 sum = Vec3::Zero();
   const SweepEntries& general = entries.general;
   const Index* columns = general.columns.data();
@@ -248,21 +250,20 @@ void backwardSweepRange(Index begin, Index end, const PackedTriangle& upper,
 }
 
 /// Forward sweep over sweep positions [begin, end) of one colour, in place, w = P_L⁻¹ w:
-/// w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j). With curvature, returns Σ c_iᵀ(t_i + w_i) over the
-/// range (ĉᵀÂĉ, Â = P_L⁻¹ Ã P_U⁻¹).
+/// w_i = D̃_i⁻¹(w_i − Σ_{earlier j} A_ij w_j). With curvature, terms[k] = c_iᵀ(t_i + w_i) for each
+/// position k of the range (summed to ĉᵀÂĉ, Â = P_L⁻¹ Ã P_U⁻¹, in a fixed order after the sweep).
 template <bool curvature>
-Real forwardSweepRange(Index begin, Index end, const PackedTriangle& lower,
+void forwardSweepRange(Index begin, Index end, const PackedTriangle& lower,
                        const MulticolorOrdering& ordering, const VertexFilter& filter,
                        const std::vector<Mat3>& inverseDiagonal, const Vec3Array& c,
-                       const Vec3Array& t, Vec3Array& w) {
-  Real sum = 0;
+                       const Vec3Array& t, Vec3Array& w, Real* terms) {
   for (Index k = begin; k < end; ++k) {
     const Index vertex = ordering.order()[k];
     const Vec3 rest = w[vertex] - triangleProduct(k, ordering.lower(), lower, w);
-    w[vertex] = filter.filter(vertex, inverseDiagonal[vertex] * rest);
-    if constexpr (curvature) sum += c[vertex].dot(t[vertex] + w[vertex]);
+    const Vec3 result = filter.filter(vertex, inverseDiagonal[vertex] * rest);
+    w[vertex] = result;
+    if constexpr (curvature) terms[k] = c[vertex].dot(t[vertex] + result);
   }
-  return sum;
 }
 
 /// The forward sweep of M_SGS⁻¹ r over sweep positions [begin, end) of one colour:
@@ -374,6 +375,7 @@ void FilteredPcg::resize(Index vertexCount) {
   m_progressRing.assign(std::size_t(PcgSettings{}.progressWindow) * std::size_t(vertexCount),
                         Vec3::Zero());
   m_blockPartials.assign((vertexCount + kReductionBlock - 1) / kReductionBlock, 0);
+  m_sweepTerms.assign(vertexCount, 0);
   m_couplingDiagonal.assign(vertexCount, Mat3::Zero());
   m_couplingProduct.assign(vertexCount, Vec3::Zero());
   m_couplingMark.assign(vertexCount, 0);
@@ -399,9 +401,32 @@ auto FilteredPcg::sumOverBlocks(Index count, Kernel&& kernel) {
 }
 
 template <typename Kernel>
+void FilteredPcg::forEachColourChunk(Index count, Kernel&& kernel) {
+  const Index threads = m_tasks ? Index(m_tasks->threadCount()) : 1;
+  if (threads <= 1 || count < 2 * kMinSweepChunk) {
+    kernel(Index(0), count);
+    return;
+  }
+  const Index chunk = std::max(kMinSweepChunk, (count + threads - 1) / threads);
+  m_tasks->parallelFor(count, chunk, [&](Index begin, Index end, int) { kernel(begin, end); });
+}
+
+Real FilteredPcg::sumSweepTerms(Index first, Index count) const {
+  // Each reduction block summed in position order from zero, the blocks' sums in block order:
+  // exactly what sumOverBlocks gives for a kernel that sums its range.
+  Real sum = 0;
+  for (Index begin = 0; begin < count; begin += kReductionBlock) {
+    const Index end = std::min(begin + kReductionBlock, count);
+    Real partial = 0;
+    for (Index k = begin; k < end; ++k) partial += m_sweepTerms[first + k];
+    sum = sum + partial;
+  }
+  return sum;
+}
+
+template <typename Kernel>
 void FilteredPcg::forEachBlock(Index count, Kernel&& kernel) {
-  // parallelFor runs a single block inline (no fork): a colour smaller than a block costs nothing
-  // in task overhead, which matters since a sweep visits every colour twice per iteration.
+  // parallelFor runs a single block inline (no fork).
   if (m_tasks) {
     m_tasks->parallelFor(count, kReductionBlock,
                          [&](Index begin, Index end, int) { kernel(begin, end); });
@@ -437,10 +462,12 @@ Real FilteredPcg::forwardSweep(const VertexFilter& filter,
   Real sum = 0;
   for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
-    sum += sumOverBlocks(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
-      return forwardSweepRange<curvature>(first + begin, first + end, m_lowerBlocks, m_ordering,
-                                          filter, m_inverseDiagonal, c, t, w);
+    const Index count = m_ordering.colorEnd(color) - first;
+    forEachColourChunk(count, [&](Index begin, Index end) {
+      forwardSweepRange<curvature>(first + begin, first + end, m_lowerBlocks, m_ordering, filter,
+                                   m_inverseDiagonal, c, t, w, m_sweepTerms.data());
     });
+    if constexpr (curvature) sum += sumSweepTerms(first, count);
   }
   return sum;
 }
@@ -449,7 +476,7 @@ void FilteredPcg::backwardSweep(const VertexFilter& filter,
                                 const Vec3Array& c, Vec3Array& t, Vec3Array& w) {
   for (Index color = m_ordering.colorCount(); color-- > 0;) {
     const Index first = m_ordering.colorBegin(color);
-    forEachBlock(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+    forEachColourChunk(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
       backwardSweepRange(first + begin, first + end, m_upperBlocks, m_ordering, filter,
                          m_inverseDiagonal, c, t, w);
     });
@@ -705,7 +732,7 @@ void FilteredPcg::applySymmetricGaussSeidel(const VertexFilter& filter, const Ve
   // w = P_L⁻¹ r and y = D̃ w in one pass, colour by colour.
   for (Index color = 0; color < m_ordering.colorCount(); ++color) {
     const Index first = m_ordering.colorBegin(color);
-    forEachBlock(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
+    forEachColourChunk(m_ordering.colorEnd(color) - first, [&](Index begin, Index end) {
       forwardSweepWithDiagonalRange(first + begin, first + end, m_lowerBlocks, m_ordering, filter,
                                     m_inverseDiagonal, m_diagonal, r, w, y);
     });

@@ -107,8 +107,9 @@
 //   bitwise identical to this serial one for any thread count. Kernels are fused per pass (e.g.
 //   x += αc, r −= αq, s = D̃⁻¹r and rᵀs in one sweep) because CG on a sparse matrix is bound by
 //   memory bandwidth; three sweeps per iteration, one of them the SpMV (Gauss–Seidel: four, two
-//   of them the half-sweeps; its curvature sum is taken colour by colour, fixed blocks within a
-//   colour, colours in order).
+//   of them the half-sweeps; a half-sweep splits each colour, whose rows are independent, into
+//   one chunk per thread, and its curvature sum is taken from per-row terms afterwards, colour by
+//   colour, fixed blocks within a colour, colours in order).
 // - Contact couplings (ContactCoupling.h). solve() may take a list of rank-one terms
 //   E = Σ coefficient · JᵀJ outside A's block pattern (self-contacts) and then solves (A + E)Δv = b,
 //   matrix-free: E = E_diag + E_off, its diagonal blocks E_ii and its coupling blocks.
@@ -223,10 +224,15 @@ class FilteredPcg {
   /// the thread count) so the summation order, and hence every bit of the result, is too; 256
   /// vertices of the four solver vectors (~24 KB) fit in L1/L2 and amortise a task's overhead.
   static constexpr Index kReductionBlock = 256;
-  /// A system of fewer rows (8 blocks) is solved on the calling thread: each of its parallel
-  /// calls would be a few blocks, whose fork and join cost more than a second thread saves. The
-  /// blocks and their order are the same, so are the bits.
-  static constexpr Index kMinParallelRows = 8 * kReductionBlock;
+  /// A system of fewer rows (2 blocks) is solved on the calling thread: its vector passes would
+  /// be one block and its colours a few dozen rows, whose fork and join cost more than a second
+  /// thread saves. The blocks and their order are the same, so are the bits.
+  static constexpr Index kMinParallelRows = 2 * kReductionBlock;
+  /// Fewest rows of one colour a sweep hands to a task. A colour's rows are independent, so a
+  /// sweep splits each colour into one chunk per thread (not into reduction blocks: the
+  /// curtain's colours are ~140 rows, under one block) and any split gives the same bits; 32
+  /// rows are ~1.5 µs of work, about twice a fork and join on two threads.
+  static constexpr Index kMinSweepChunk = 32;
 
   /// Allocates scratch for vertexCount vertices; solve() then never allocates for that size.
   void resize(Index vertexCount);
@@ -265,9 +271,10 @@ class FilteredPcg {
                            TaskSystem* tasks = nullptr);
 
  private:
-  // The task system a system of `rows` rows runs on: none below kMinParallelRows.
+  // The task system a system of `rows` rows runs on: none below kMinParallelRows, nor one of a
+  // single thread (whose parallel calls would only add their overhead).
   static TaskSystem* tasksFor(Index rows, TaskSystem* tasks) {
-    return rows >= kMinParallelRows ? tasks : nullptr;
+    return rows >= kMinParallelRows && tasks && !tasks->isSerial() ? tasks : nullptr;
   }
 
   /// Runs kernel(begin, end) over the fixed reduction blocks of [0, count) (all vertices, or a
@@ -279,6 +286,15 @@ class FilteredPcg {
   /// Runs kernel(begin, end) over the fixed reduction blocks of [0, count) (no reduction).
   template <typename Kernel>
   void forEachBlock(Index count, Kernel&& kernel);
+
+  /// Runs kernel(begin, end) over [0, count) (one colour's sweep positions) in one chunk per
+  /// thread of at least kMinSweepChunk rows; the rows are independent, so the split is free.
+  template <typename Kernel>
+  void forEachColourChunk(Index count, Kernel&& kernel);
+
+  /// The sum of m_sweepTerms over sweep positions [first, first + count), combined as
+  /// sumOverBlocks combines a colour's reduction blocks.
+  Real sumSweepTerms(Index first, Index count) const;
 
   /// w = P_L⁻¹ w in place, colour by colour; with curvature, returns Σ cᵀ(t + w).
   template <bool curvature>
@@ -349,6 +365,7 @@ class FilteredPcg {
   std::vector<Mat3> m_diagonal;         ///< D̃_i per vertex: A's diagonal blocks, dense
   std::vector<Mat3> m_inverseDiagonal;  ///< D̃_i⁻¹ per vertex (filtered block-Jacobi)
   std::vector<Real> m_blockPartials;    ///< one partial sum per reduction block
+  std::vector<Real> m_sweepTerms;       ///< per sweep position, the forward sweep's curvature term
   std::span<const Index> m_rowColors;   ///< setRowColors(); empty: colour A's pattern
   MulticolorOrdering m_ordering;        ///< order of A's rows (Gauss–Seidel only)
   AggregateCoarseSpace m_coarseSpace;   ///< the two-level preconditioner's coarse level

@@ -86,8 +86,8 @@ class VertexFilter {
   const Vec3& direction(Index vertex, int k) const { return m_directions[vertex][k]; }
 
   /// S_i v for one vertex. Fixed vertices return exact zeros (not 0·v), so a NaN in a fixed
-  /// vertex's row cannot leak into the solve.
-  Vec3 filter(Index vertex, const Vec3& v) const {
+  /// vertex's row cannot leak into the solve. Always inlined: the PCG's sweeps call it per row.
+  [[gnu::always_inline]] Vec3 filter(Index vertex, const Vec3& v) const {
     switch (static_cast<ConstraintKind>(m_kinds[vertex])) {
       case ConstraintKind::Free:
         return v;
