@@ -33,8 +33,9 @@ namespace weft {
 /// Whether the boxes of two features' paths (the positions of vertices `first`, and of `second`,
 /// from `from` to `to`) come within `reach` (m) of each other. When they do not, no point of one
 /// feature comes that close to the other over the path, and the exact test need not run. Pass
-/// the same positions as `from` and `to` for the features at one time.
-inline bool featureBoxesWithin(std::initializer_list<Index> first,
+/// the same positions as `from` and `to` for the features at one time. Always inlined, so that
+/// the lists of vertices unroll: the narrow phase and the swept tests ask it for every pair.
+[[gnu::always_inline]] inline bool featureBoxesWithin(std::initializer_list<Index> first,
                                std::initializer_list<Index> second, const Vec3Array& from,
                                const Vec3Array& to, Real reach) {
   Aabb a = Aabb::empty(), b = Aabb::empty();
