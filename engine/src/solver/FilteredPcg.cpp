@@ -411,19 +411,6 @@ void FilteredPcg::forEachColourChunk(Index count, Kernel&& kernel) {
   m_tasks->parallelFor(count, chunk, [&](Index begin, Index end, int) { kernel(begin, end); });
 }
 
-Real FilteredPcg::sumSweepTerms(Index first, Index count) const {
-  // Each reduction block summed in position order from zero, the blocks' sums in block order:
-  // exactly what sumOverBlocks gives for a kernel that sums its range.
-  Real sum = 0;
-  for (Index begin = 0; begin < count; begin += kReductionBlock) {
-    const Index end = std::min(begin + kReductionBlock, count);
-    Real partial = 0;
-    for (Index k = begin; k < end; ++k) partial += m_sweepTerms[first + k];
-    sum = sum + partial;
-  }
-  return sum;
-}
-
 template <typename Kernel>
 void FilteredPcg::forEachBlock(Index count, Kernel&& kernel) {
   // parallelFor runs a single block inline (no fork).
@@ -467,7 +454,14 @@ Real FilteredPcg::forwardSweep(const VertexFilter& filter,
       forwardSweepRange<curvature>(first + begin, first + end, m_lowerBlocks, m_ordering, filter,
                                    m_inverseDiagonal, c, t, w, m_sweepTerms.data());
     });
-    if constexpr (curvature) sum += sumSweepTerms(first, count);
+    if constexpr (curvature) {
+      // The terms in the colour's reduction blocks, as the sweep itself summed them.
+      sum += sumOverBlocks(count, [&](Index begin, Index end) {
+        Real partial = 0;
+        for (Index k = first + begin; k < first + end; ++k) partial += m_sweepTerms[k];
+        return partial;
+      });
+    }
   }
   return sum;
 }

@@ -292,10 +292,6 @@ class FilteredPcg {
   template <typename Kernel>
   void forEachColourChunk(Index count, Kernel&& kernel);
 
-  /// The sum of m_sweepTerms over sweep positions [first, first + count), combined as
-  /// sumOverBlocks combines a colour's reduction blocks.
-  Real sumSweepTerms(Index first, Index count) const;
-
   /// w = P_L⁻¹ w in place, colour by colour; with curvature, returns Σ cᵀ(t + w).
   template <bool curvature>
   Real forwardSweep(const VertexFilter& filter, const Vec3Array& c, const Vec3Array& t,
